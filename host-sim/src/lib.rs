@@ -1,0 +1,2 @@
+//! tss-sim: the desktop simulator of the tss-reel controller.
+#![warn(missing_docs)]

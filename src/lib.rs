@@ -1,0 +1,15 @@
+//! # tss-reel: the reel controller of a tethered satellite system
+//!
+//! A `no_std`, allocation-free, panic-free implementation of the range-rate control system of
+//! He, Liang & Xu, "Study on the stability of Tethered Satellite System", *Acta Astronautica* 68
+//! (2011) 1964–1972, with the corrections of this project's SPEC. Equation numbers in the docs
+//! are the paper's.
+#![no_std]
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod mass;
+pub mod orbit;
+pub mod real;
+
+pub use real::Real;

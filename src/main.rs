@@ -1,0 +1,2 @@
+//! Firmware placeholder until the platform lands.
+fn main() {}

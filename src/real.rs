@@ -1,0 +1,199 @@
+//! The scalar type the physics is written in.
+//!
+//! The flight build evaluates everything in `f32` (the Cortex-M4F has a single-precision FPU);
+//! the desk tools and the accuracy tests evaluate the *same* formulas in `f64`. Writing each
+//! formula once, generic over [`Real`], means the two can only differ by rounding.
+
+use core::fmt::Debug;
+use core::ops::{Add, Div, Mul, Neg, Sub};
+
+/// A real scalar (`f32` or `f64`) with the handful of functions the paper's equations need.
+///
+/// Transcendental functions come from `libm`, so results are identical on the host and on the
+/// target (no dependence on the platform's C library).
+pub trait Real:
+    Copy
+    + Debug
+    + PartialOrd
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// 0.
+    const ZERO: Self;
+    /// 1.
+    const ONE: Self;
+    /// Converts an `f64` constant (rounding to nearest for `f32`).
+    fn from_f64(x: f64) -> Self;
+    /// Converts to `f64` (exact for both implementations).
+    fn to_f64(self) -> f64;
+    /// Sine.
+    fn sin(self) -> Self;
+    /// Cosine.
+    fn cos(self) -> Self;
+    /// `e^x`.
+    fn exp(self) -> Self;
+    /// Square root (NaN for negative input).
+    fn sqrt(self) -> Self;
+    /// Absolute value.
+    fn abs(self) -> Self;
+    /// Four-quadrant arctangent of `self / x`.
+    fn atan2(self, x: Self) -> Self;
+    /// Arcsine (NaN outside [-1, 1]).
+    fn asin(self) -> Self;
+    /// `true` unless NaN or infinite.
+    fn is_finite(self) -> bool;
+
+    /// The smaller of two values (the non-NaN one if one is NaN).
+    #[inline]
+    fn min(self, other: Self) -> Self {
+        if other < self || self.is_nan() {
+            other
+        } else {
+            self
+        }
+    }
+    /// The larger of two values (the non-NaN one if one is NaN).
+    #[inline]
+    fn max(self, other: Self) -> Self {
+        if other > self || self.is_nan() {
+            other
+        } else {
+            self
+        }
+    }
+    /// `self` limited to `[lo, hi]` (`lo` if `self` is NaN).
+    #[inline]
+    fn clamp_to(self, lo: Self, hi: Self) -> Self {
+        if self.is_nan() {
+            lo
+        } else {
+            self.max(lo).min(hi)
+        }
+    }
+    /// `true` for NaN.
+    #[inline]
+    #[allow(clippy::eq_op)]
+    fn is_nan(self) -> bool {
+        self != self
+    }
+    /// The square, `self * self`.
+    #[inline]
+    fn sq(self) -> Self {
+        self * self
+    }
+}
+
+impl Real for f32 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    #[inline]
+    fn from_f64(x: f64) -> Self {
+        x as f32
+    }
+    #[inline]
+    fn to_f64(self) -> f64 {
+        f64::from(self)
+    }
+    #[inline]
+    fn sin(self) -> Self {
+        libm::sinf(self)
+    }
+    #[inline]
+    fn cos(self) -> Self {
+        libm::cosf(self)
+    }
+    #[inline]
+    fn exp(self) -> Self {
+        libm::expf(self)
+    }
+    #[inline]
+    fn sqrt(self) -> Self {
+        libm::sqrtf(self)
+    }
+    #[inline]
+    fn abs(self) -> Self {
+        libm::fabsf(self)
+    }
+    #[inline]
+    fn atan2(self, x: Self) -> Self {
+        libm::atan2f(self, x)
+    }
+    #[inline]
+    fn asin(self) -> Self {
+        libm::asinf(self)
+    }
+    #[inline]
+    fn is_finite(self) -> bool {
+        f32::is_finite(self)
+    }
+}
+
+impl Real for f64 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    #[inline]
+    fn from_f64(x: f64) -> Self {
+        x
+    }
+    #[inline]
+    fn to_f64(self) -> f64 {
+        self
+    }
+    #[inline]
+    fn sin(self) -> Self {
+        libm::sin(self)
+    }
+    #[inline]
+    fn cos(self) -> Self {
+        libm::cos(self)
+    }
+    #[inline]
+    fn exp(self) -> Self {
+        libm::exp(self)
+    }
+    #[inline]
+    fn sqrt(self) -> Self {
+        libm::sqrt(self)
+    }
+    #[inline]
+    fn abs(self) -> Self {
+        libm::fabs(self)
+    }
+    #[inline]
+    fn atan2(self, x: Self) -> Self {
+        libm::atan2(self, x)
+    }
+    #[inline]
+    fn asin(self) -> Self {
+        libm::asin(self)
+    }
+    #[inline]
+    fn is_finite(self) -> bool {
+        f64::is_finite(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Real;
+
+    #[test]
+    fn min_max_clamp_treat_nan_as_missing() {
+        assert_eq!(Real::min(f32::NAN, 1.0), 1.0);
+        assert_eq!(Real::max(2.0_f64, f64::NAN), 2.0);
+        assert_eq!(f32::NAN.clamp_to(-1.0, 1.0), -1.0);
+        assert_eq!(5.0_f32.clamp_to(-1.0, 1.0), 1.0);
+        assert_eq!((-5.0_f64).clamp_to(-1.0, 1.0), -1.0);
+    }
+
+    #[test]
+    fn f32_and_f64_agree_to_single_precision() {
+        for &x in &[0.0, 0.3, 1.0, -2.5, 3.0] {
+            assert!((Real::sin(x as f32).to_f64() - Real::sin(x)).abs() < 1e-6);
+            assert!((Real::exp(x as f32).to_f64() - Real::exp(x)).abs() < 1e-5 * x.exp());
+        }
+    }
+}

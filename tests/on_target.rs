@@ -1,0 +1,2 @@
+//! On-target tests (placeholder until the platform lands).
+fn main() {}
