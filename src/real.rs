@@ -29,6 +29,8 @@ pub trait Real:
     fn from_f64(x: f64) -> Self;
     /// Converts to `f64` (exact for both implementations).
     fn to_f64(self) -> f64;
+    /// Converts a tick count (exact below 2²⁴ for `f32`).
+    fn from_u32(x: u32) -> Self;
     /// Sine.
     fn sin(self) -> Self;
     /// Cosine.
@@ -98,6 +100,10 @@ impl Real for f32 {
         f64::from(self)
     }
     #[inline]
+    fn from_u32(x: u32) -> Self {
+        x as f32
+    }
+    #[inline]
     fn sin(self) -> Self {
         libm::sinf(self)
     }
@@ -141,6 +147,10 @@ impl Real for f64 {
     #[inline]
     fn to_f64(self) -> f64 {
         self
+    }
+    #[inline]
+    fn from_u32(x: u32) -> Self {
+        f64::from(x)
     }
     #[inline]
     fn sin(self) -> Self {

@@ -1,0 +1,78 @@
+//! The simulated mission's time history: one [`Sample`] per output interval.
+//!
+//! This is the contract between the closed-loop simulation (`sim`) and everything that reports
+//! on it (CSV, figures, Table 1, summary).
+
+/// Mission phase as reported by the controller, in the order they occur.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum PhaseLabel {
+    /// Stage 1: paying out toward the stage-1 keep length.
+    Deploy,
+    /// Stage 1: holding at the stage-1 keep length (30 km in the paper).
+    Keep1,
+    /// Stage 2: α_r slewing from 0 to its plateau.
+    Slew,
+    /// Stage 2: winding in toward the stage-2 keep length.
+    Retrieve,
+    /// Stage 2: holding at the stage-2 keep length (2 km in the paper).
+    Keep2,
+}
+
+impl PhaseLabel {
+    /// The label written in `history.csv`'s `phase` column.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Deploy => "deploy",
+            Self::Keep1 => "keep1",
+            Self::Slew => "slew",
+            Self::Retrieve => "retrieve",
+            Self::Keep2 => "keep2",
+        }
+    }
+}
+
+/// One recorded instant of the closed-loop mission (plant state in f64, controller outputs
+/// widened from f32).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// Mission time, s (computed from the integer tick count).
+    pub t_s: f64,
+    /// Tether length l, m (plant truth).
+    pub length_m: f64,
+    /// Reel rate l̇ applied over the period that starts at this instant, m/s (the command).
+    pub length_rate_mps: f64,
+    /// In-plane angle α, rad (plant truth).
+    pub alpha_rad: f64,
+    /// In-plane angle rate α̇, rad/s (plant truth).
+    pub alpha_rate_radps: f64,
+    /// Reference angle α_r, rad (controller).
+    pub alpha_ref_rad: f64,
+    /// δ = α − α_r, rad (controller).
+    pub delta_rad: f64,
+    /// δ̇ = α̇ − α̇_r, rad/s (controller, consistent with the command).
+    pub delta_rate_radps: f64,
+    /// Out-of-plane angle β, rad (plant truth).
+    pub beta_rad: f64,
+    /// Tether tension T_t from Eq. 5a with l̈ = the commanded reel acceleration, N.
+    pub tension_n: f64,
+    /// Commanded reel acceleration, m/s² (Eq. 30, sign corrected).
+    pub length_accel_mps2: f64,
+    /// The Eq. 27 value l̇ (before the Eq. 29 blend), m/s.
+    pub law_rate_mps: f64,
+    /// Blend weight e^{−cτ} of Eq. 29 (1 at a stage start, → 0).
+    pub blend_weight: f64,
+    /// Mission phase.
+    pub phase: PhaseLabel,
+    /// Controller status flags (raw bits of `tss_reel` output flags).
+    pub flags: u32,
+}
+
+/// The result of a closed-loop run.
+#[derive(Clone, Debug, Default)]
+pub struct History {
+    /// Samples at the output interval, starting at t = 0 and including the final instant.
+    pub samples: Vec<Sample>,
+    /// Length at every Table-1 instant requested by the caller of `sim::run` (t_s, length_m), in order,
+    /// taken at the exact control tick (not interpolated).
+    pub probes: Vec<(f64, f64)>,
+}

@@ -1,0 +1,1147 @@
+//! Scenario files: the TOML description of one simulated mission.
+//!
+//! `scenarios/paper.toml` is the paper's Section 6 as fixed in SPEC §7. Every field has a
+//! unit in its name. Loading, `--set` overrides and validation live in this module.
+
+use serde::{Deserialize, Serialize};
+
+/// A complete mission scenario.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Short name, used in titles and file names.
+    pub name: String,
+    /// One line saying what the scenario is.
+    #[serde(default)]
+    pub description: String,
+    /// Orbit of the system's centre of mass.
+    pub orbit: OrbitSection,
+    /// Satellite masses.
+    pub masses: MassesSection,
+    /// Tether properties.
+    pub tether: TetherSection,
+    /// Initial state at t = 0.
+    pub initial: InitialSection,
+    /// Controller gains and period.
+    pub controller: ControllerSection,
+    /// Stage 1: deploy, then keep.
+    pub stage1: Stage1Section,
+    /// Stage 2: slew, retrieve, then keep.
+    pub stage2: Stage2Section,
+    /// Run length and output.
+    pub simulation: SimulationSection,
+    /// Reel limits enforced by the controller (defaults: the paper's, 15 m/s, 15 m/s², 0.5 m to
+    /// 40 km, wide enough never to act in the paper's mission).
+    #[serde(default)]
+    pub envelope: EnvelopeSection,
+}
+
+/// `[envelope]`: the reel's operating limits.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvelopeSection {
+    /// Largest reel speed, m/s.
+    pub max_rate_mps: f64,
+    /// Largest reel acceleration, m/s².
+    pub max_accel_mps2: f64,
+    /// Shortest tether (docking), m.
+    pub min_length_m: f64,
+    /// Longest tether (spool capacity), m.
+    pub max_length_m: f64,
+}
+
+impl Default for EnvelopeSection {
+    fn default() -> Self {
+        Self {
+            max_rate_mps: 15.0,
+            max_accel_mps2: 15.0,
+            min_length_m: 0.5,
+            max_length_m: 40_000.0,
+        }
+    }
+}
+
+/// `[orbit]`
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OrbitSection {
+    /// Semi-major axis a (the radius of a circular orbit), m.
+    pub semi_major_axis_m: f64,
+    /// Eccentricity e, in [0, 1).
+    #[serde(default)]
+    pub eccentricity: f64,
+    /// True anomaly θ at t = 0, rad.
+    #[serde(default)]
+    pub initial_true_anomaly_rad: f64,
+}
+
+/// `[masses]`
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MassesSection {
+    /// m01, main satellite with the whole tether on the reel, kg.
+    pub main_initial_kg: f64,
+    /// m2, sub-satellite, kg.
+    pub sub_kg: f64,
+}
+
+/// `[tether]`
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TetherSection {
+    /// ρ, linear density, kg/m (0 = massless, the paper's run).
+    #[serde(default)]
+    pub density_kg_per_m: f64,
+}
+
+/// `[initial]`
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialSection {
+    /// l(0), m.
+    pub length_m: f64,
+    /// l̇0 = l̇_real(0), the reel's initial rate, m/s.
+    pub length_rate_mps: f64,
+    /// δ(0) = α(0) − α_r(0), rad.
+    pub delta_rad: f64,
+    /// δ̇(0), rad/s.
+    #[serde(default)]
+    pub delta_rate_radps: f64,
+    /// β(0), rad.
+    #[serde(default)]
+    pub beta_rad: f64,
+    /// β̇(0), rad/s.
+    #[serde(default)]
+    pub beta_rate_radps: f64,
+}
+
+/// `[controller]`
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControllerSection {
+    /// Control period (and zero-order-hold interval of the reel command), s.
+    pub period_s: f64,
+    /// k1 of Eq. 27, 1/s.
+    pub k1_per_s: f64,
+    /// k2 of Eq. 27, 1/s².
+    pub k2_per_s2: f64,
+    /// A keep phase begins when l is within this distance of its keep length, m.
+    #[serde(default = "one_f64")]
+    pub keep_capture_m: f64,
+}
+
+/// `[stage1]`: Eq. 34.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Stage1Section {
+    /// c of Eq. 29 in stage 1, 1/s.
+    pub decay_rate_per_s: f64,
+    /// α_r while deploying (l ≤ band start), rad.
+    pub deploy_angle_rad: f64,
+    /// Start of the transition band (10 km in the paper), m.
+    pub band_start_m: f64,
+    /// Keep length, the end of the band (30 km), m.
+    pub keep_length_m: f64,
+    /// Slope k of α_r = k(l − keep) beyond the keep length, rad/m.
+    pub keep_slope_rad_per_m: f64,
+}
+
+/// `[stage2]`: the slew and Eq. 35.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Stage2Section {
+    /// Mission time at which stage 2 begins, s (8 h in the paper).
+    pub start_time_s: f64,
+    /// c of Eq. 29 in stage 2, 1/s.
+    pub decay_rate_per_s: f64,
+    /// α_r plateau while retrieving (l ≥ band end), rad.
+    pub retrieve_angle_rad: f64,
+    /// Slew rate of α_r from 0 to the plateau, rad/s.
+    pub slew_rate_radps: f64,
+    /// Upper end of the transition band (5 km), m.
+    pub band_start_m: f64,
+    /// Keep length, the lower end of the band (2 km), m.
+    pub keep_length_m: f64,
+    /// Slope k of α_r = k(l − keep) below the keep length, rad/m.
+    pub keep_slope_rad_per_m: f64,
+}
+
+/// `[simulation]`
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimulationSection {
+    /// Mission length, s.
+    pub duration_s: f64,
+    /// RK4 sub-steps per control period (≥ 1).
+    #[serde(default = "one")]
+    pub substeps: u32,
+    /// Interval between rows of history.csv, s (a multiple of the control period).
+    #[serde(default = "ten")]
+    pub output_interval_s: f64,
+}
+
+fn one_f64() -> f64 {
+    1.0
+}
+fn one() -> u32 {
+    1
+}
+fn ten() -> f64 {
+    10.0
+}
+
+// ---------------------------------------------------------------------------------------------
+// Loading, `--set` overrides and validation.
+// ---------------------------------------------------------------------------------------------
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt;
+use std::path::Path;
+use std::sync::OnceLock;
+
+/// Equatorial radius of the Earth (WGS-84), m: the orbit's perigee must lie above it.
+pub const EARTH_EQUATORIAL_RADIUS_M: f64 = 6_378_137.0;
+
+/// Relative tolerance when checking that one interval is a whole multiple of another
+/// (e.g. the output interval of the control period): 1e-9 of the ratio.
+const WHOLE_MULTIPLE_REL_TOL: f64 = 1e-9;
+
+/// The simulator counts control ticks in a `u32`: a run may last at most this many periods.
+pub const MAX_TICKS: f64 = u32::MAX as f64;
+
+/// Why a scenario could not be loaded. Every message names the file and, where there is one,
+/// the field (dotted path, e.g. `stage1.band_start_m`) and the value at fault.
+#[derive(Debug, thiserror::Error)]
+pub enum ScenarioError {
+    /// The file could not be read.
+    #[error("{file}: cannot read the scenario file")]
+    Io {
+        /// The scenario file, as given.
+        file: String,
+        /// The underlying I/O error.
+        #[source]
+        error: std::io::Error,
+    },
+    /// The file is not valid TOML.
+    #[error("{file}: not valid TOML: {message}")]
+    Syntax {
+        /// The scenario file, as given.
+        file: String,
+        /// The TOML parser's message (with line and column).
+        message: String,
+    },
+    /// A `--set` argument is not of the form `key=value`.
+    #[error("{file}: --set {arg:?}: {message}")]
+    BadOverride {
+        /// The scenario file, as given.
+        file: String,
+        /// The `--set` argument as given.
+        arg: String,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// A key (in the file or in a `--set`) that the scenario does not have.
+    #[error("{file}: {origin}unknown key `{key}` ({hint})")]
+    UnknownKey {
+        /// The scenario file, as given.
+        file: String,
+        /// `"--set k=v: "` when the key came from an override, else empty.
+        origin: String,
+        /// The dotted key.
+        key: String,
+        /// The keys that are valid at that place.
+        hint: String,
+    },
+    /// A value of the wrong type (a string for a number, a float for an integer, …).
+    #[error("{file}: {origin}{key} = {value} {message}")]
+    WrongType {
+        /// The scenario file, as given.
+        file: String,
+        /// `"--set k=v: "` when the value came from an override, else empty.
+        origin: String,
+        /// The dotted key.
+        key: String,
+        /// The offending value, as TOML.
+        value: String,
+        /// What was expected.
+        message: String,
+    },
+    /// A required key is absent.
+    #[error("{file}: missing key `{key}`")]
+    MissingKey {
+        /// The scenario file, as given.
+        file: String,
+        /// The dotted key.
+        key: String,
+    },
+    /// Any other deserialization failure (the TOML library's message).
+    #[error("{file}: {message}")]
+    Deserialize {
+        /// The scenario file, as given.
+        file: String,
+        /// The deserializer's message.
+        message: String,
+    },
+    /// The scenario deserialized but makes no physical sense: one line per problem.
+    #[error("{}", format_problems(file, problems))]
+    Invalid {
+        /// The scenario file, as given.
+        file: String,
+        /// Every rule that failed, in field order.
+        problems: Vec<Problem>,
+    },
+}
+
+/// One failed validation rule: `field = value message`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Problem {
+    /// Dotted path of the field at fault, e.g. `stage1.band_start_m`.
+    pub field: String,
+    /// The offending value as written in messages.
+    pub value: String,
+    /// What is wrong, e.g. `must be below stage1.keep_length_m = 30000`.
+    pub message: String,
+    /// True when the value came from a `--set` override.
+    pub from_override: bool,
+}
+
+impl fmt::Display for Problem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} = {} {}", self.field, self.value, self.message)?;
+        if self.from_override {
+            write!(f, " (set by --set)")?;
+        }
+        Ok(())
+    }
+}
+
+fn format_problems(file: &str, problems: &[Problem]) -> String {
+    let lines: Vec<String> = problems.iter().map(|p| format!("{file}: {p}")).collect();
+    lines.join("\n")
+}
+
+impl Scenario {
+    /// Reads a scenario file, applies `--set key=value` overrides (dotted keys, values parsed as
+    /// TOML scalars; a bare word is a string), deserializes and validates it.
+    ///
+    /// ```
+    /// # use tss_sim::scenario::Scenario;
+    /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/paper.toml");
+    /// let s = Scenario::load(path, &["simulation.duration_s=3600".to_string()]).unwrap();
+    /// assert_eq!(s.simulation.duration_s, 3600.0);
+    /// ```
+    pub fn load(path: impl AsRef<Path>, overrides: &[String]) -> Result<Scenario, ScenarioError> {
+        let path = path.as_ref();
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|error| ScenarioError::Io {
+            file: file.clone(),
+            error,
+        })?;
+        Self::from_toml_str(&text, &file, overrides)
+    }
+
+    /// Like [`Scenario::load`] on text already read; `file` is the name used in messages.
+    pub fn from_toml_str(
+        text: &str,
+        file: &str,
+        overrides: &[String],
+    ) -> Result<Scenario, ScenarioError> {
+        let mut table: toml::Table = toml::from_str(text).map_err(|e| ScenarioError::Syntax {
+            file: file.to_string(),
+            message: e.to_string().trim_end().to_string(),
+        })?;
+        let schema = schema();
+        check_table(&table, "", schema, file, "")?;
+        let mut overridden = BTreeSet::new();
+        for arg in overrides {
+            let key = apply_override(&mut table, arg, schema, file)?;
+            overridden.insert(key);
+        }
+        let scenario: Scenario = toml::Value::Table(table.clone())
+            .try_into()
+            .map_err(|e: toml::de::Error| deserialize_error(&e, &table, schema, file))?;
+        let mut problems = scenario.problems();
+        if problems.is_empty() {
+            return Ok(scenario);
+        }
+        for p in &mut problems {
+            p.from_override = overridden.contains(&p.field);
+        }
+        Err(ScenarioError::Invalid {
+            file: file.to_string(),
+            problems,
+        })
+    }
+
+    /// Checks that the scenario makes physical sense; returns every failed rule (empty = valid).
+    pub fn problems(&self) -> Vec<Problem> {
+        let mut v = Validator::default();
+        let s = self;
+
+        // name: it names the default output directory.
+        let name_ok = !s.name.trim().is_empty()
+            && s.name != "."
+            && s.name != ".."
+            && !s.name.chars().any(|c| c == '/' || c == '\\' || c.is_control());
+        v.check(
+            name_ok,
+            "name",
+            format!("{:?}", s.name),
+            "must be a non-empty file name (no '/', '\\' or control characters, not '.' or '..')",
+        );
+
+        // [orbit]
+        let o = &s.orbit;
+        v.positive("orbit.semi_major_axis_m", o.semi_major_axis_m);
+        if v.finite("orbit.eccentricity", o.eccentricity) {
+            v.check(
+                (0.0..1.0).contains(&o.eccentricity),
+                "orbit.eccentricity",
+                num(o.eccentricity),
+                "must be in [0, 1)",
+            );
+        }
+        v.finite("orbit.initial_true_anomaly_rad", o.initial_true_anomaly_rad);
+        if o.semi_major_axis_m.is_finite()
+            && o.semi_major_axis_m > 0.0
+            && (0.0..1.0).contains(&o.eccentricity)
+        {
+            let perigee_m = o.semi_major_axis_m * (1.0 - o.eccentricity);
+            v.check(
+                perigee_m > EARTH_EQUATORIAL_RADIUS_M,
+                "orbit.semi_major_axis_m",
+                num(o.semi_major_axis_m),
+                &format!(
+                    "puts the perigee a(1 − e) = {} m (orbit.eccentricity = {}) inside the Earth \
+                     (radius {EARTH_EQUATORIAL_RADIUS_M} m)",
+                    num(perigee_m),
+                    num(o.eccentricity)
+                ),
+            );
+        }
+
+        // [masses]
+        v.positive("masses.main_initial_kg", s.masses.main_initial_kg);
+        v.positive("masses.sub_kg", s.masses.sub_kg);
+
+        // [initial]
+        let i = &s.initial;
+        v.positive("initial.length_m", i.length_m);
+        v.finite("initial.length_rate_mps", i.length_rate_mps);
+        v.finite("initial.delta_rad", i.delta_rad);
+        v.finite("initial.delta_rate_radps", i.delta_rate_radps);
+        if v.finite("initial.beta_rad", i.beta_rad) {
+            v.check(
+                i.beta_rad.abs() < std::f64::consts::FRAC_PI_2,
+                "initial.beta_rad",
+                num(i.beta_rad),
+                "must be within (−π/2, π/2)",
+            );
+        }
+        v.finite("initial.beta_rate_radps", i.beta_rate_radps);
+
+        // [controller]
+        let c = &s.controller;
+        v.positive("controller.period_s", c.period_s);
+        v.positive("controller.k1_per_s", c.k1_per_s);
+        v.positive("controller.k2_per_s2", c.k2_per_s2);
+        v.positive("controller.keep_capture_m", c.keep_capture_m);
+
+        // [envelope]: the reel's limits, which the controller enforces.
+        let env = &s.envelope;
+        let rate_ok = v.positive("envelope.max_rate_mps", env.max_rate_mps);
+        v.positive("envelope.max_accel_mps2", env.max_accel_mps2);
+        let min_ok = v.positive("envelope.min_length_m", env.min_length_m);
+        let max_ok = v.positive("envelope.max_length_m", env.max_length_m);
+        let env_ok = min_ok
+            && max_ok
+            && v.check(
+                env.min_length_m < env.max_length_m,
+                "envelope.max_length_m",
+                num(env.max_length_m),
+                &format!(
+                    "must be above envelope.min_length_m = {}",
+                    num(env.min_length_m)
+                ),
+            );
+        if rate_ok && i.length_rate_mps.is_finite() {
+            v.check(
+                i.length_rate_mps.abs() <= env.max_rate_mps,
+                "initial.length_rate_mps",
+                num(i.length_rate_mps),
+                &format!(
+                    "must be within ±envelope.max_rate_mps = {}",
+                    num(env.max_rate_mps)
+                ),
+            );
+        }
+        if env_ok && i.length_m.is_finite() && i.length_m > 0.0 {
+            v.check(
+                (env.min_length_m..=env.max_length_m).contains(&i.length_m),
+                "initial.length_m",
+                num(i.length_m),
+                &format!(
+                    "must be within [envelope.min_length_m, envelope.max_length_m] = [{}, {}]",
+                    num(env.min_length_m),
+                    num(env.max_length_m)
+                ),
+            );
+        }
+
+        // [stage1]: Eq. 34
+        let s1 = &s.stage1;
+        v.non_negative("stage1.decay_rate_per_s", s1.decay_rate_per_s);
+        v.angle_in_open_range(
+            "stage1.deploy_angle_rad",
+            s1.deploy_angle_rad,
+            (-std::f64::consts::FRAC_PI_2, 0.0),
+            "(−π/2, 0) (the deployment side, Eq. 33)",
+        );
+        let s1_band = v.positive("stage1.band_start_m", s1.band_start_m);
+        let s1_keep = v.positive("stage1.keep_length_m", s1.keep_length_m);
+        if s1_band && s1_keep {
+            v.check(
+                s1.band_start_m < s1.keep_length_m,
+                "stage1.band_start_m",
+                num(s1.band_start_m),
+                &format!(
+                    "must be below stage1.keep_length_m = {}",
+                    num(s1.keep_length_m)
+                ),
+            );
+        }
+        v.non_negative("stage1.keep_slope_rad_per_m", s1.keep_slope_rad_per_m);
+
+        // [stage2]: slew, then Eq. 35
+        let s2 = &s.stage2;
+        if v.non_negative("stage2.start_time_s", s2.start_time_s) {
+            v.whole_multiple_of_period("stage2.start_time_s", s2.start_time_s, c.period_s, true);
+        }
+        v.non_negative("stage2.decay_rate_per_s", s2.decay_rate_per_s);
+        v.angle_in_open_range(
+            "stage2.retrieve_angle_rad",
+            s2.retrieve_angle_rad,
+            (0.0, std::f64::consts::FRAC_PI_2),
+            "(0, π/2) (the retrieval side, Eq. 33)",
+        );
+        v.positive("stage2.slew_rate_radps", s2.slew_rate_radps);
+        let s2_band = v.positive("stage2.band_start_m", s2.band_start_m);
+        let s2_keep = v.positive("stage2.keep_length_m", s2.keep_length_m);
+        if s2_band && s2_keep {
+            v.check(
+                s2.keep_length_m < s2.band_start_m,
+                "stage2.band_start_m",
+                num(s2.band_start_m),
+                &format!(
+                    "must be above stage2.keep_length_m = {}",
+                    num(s2.keep_length_m)
+                ),
+            );
+        }
+        if s2_keep && s1_keep {
+            v.check(
+                s2.keep_length_m < s1.keep_length_m,
+                "stage2.keep_length_m",
+                num(s2.keep_length_m),
+                &format!(
+                    "must be below stage1.keep_length_m = {} (stage 2 retrieves)",
+                    num(s1.keep_length_m)
+                ),
+            );
+        }
+        v.non_negative("stage2.keep_slope_rad_per_m", s2.keep_slope_rad_per_m);
+        if env_ok {
+            for (field, keep, ok) in [
+                ("stage1.keep_length_m", s1.keep_length_m, s1_keep),
+                ("stage2.keep_length_m", s2.keep_length_m, s2_keep),
+            ] {
+                if ok {
+                    v.check(
+                        keep > env.min_length_m && keep < env.max_length_m,
+                        field,
+                        num(keep),
+                        &format!(
+                            "must be inside the envelope (envelope.min_length_m = {}, \
+                             envelope.max_length_m = {})",
+                            num(env.min_length_m),
+                            num(env.max_length_m)
+                        ),
+                    );
+                }
+            }
+        }
+
+        // [tether]: ρ ≥ 0 and the tether never outweighs the main satellite, even paid out to
+        // the longest length the envelope allows.
+        if v.non_negative("tether.density_kg_per_m", s.tether.density_kg_per_m) {
+            let longest_m = env.max_length_m;
+            let tether_kg = s.tether.density_kg_per_m * longest_m;
+            if max_ok && s.masses.main_initial_kg.is_finite() {
+                v.check(
+                    tether_kg < s.masses.main_initial_kg,
+                    "tether.density_kg_per_m",
+                    num(s.tether.density_kg_per_m),
+                    &format!(
+                        "makes the tether at envelope.max_length_m = {} m weigh {} kg, not \
+                         below masses.main_initial_kg = {}",
+                        num(longest_m),
+                        num(tether_kg),
+                        num(s.masses.main_initial_kg)
+                    ),
+                );
+            }
+        }
+
+        // [simulation]
+        let sim = &s.simulation;
+        if v.positive("simulation.duration_s", sim.duration_s) {
+            v.whole_multiple_of_period("simulation.duration_s", sim.duration_s, c.period_s, false);
+            if c.period_s.is_finite() && c.period_s > 0.0 {
+                let ticks = (sim.duration_s / c.period_s).round();
+                v.check(
+                    ticks <= MAX_TICKS,
+                    "simulation.duration_s",
+                    num(sim.duration_s),
+                    &format!(
+                        "is {ticks} control periods, more than the simulator's {MAX_TICKS}"
+                    ),
+                );
+            }
+        }
+        v.check(
+            sim.substeps >= 1,
+            "simulation.substeps",
+            sim.substeps.to_string(),
+            "must be at least 1",
+        );
+        if v.positive("simulation.output_interval_s", sim.output_interval_s) {
+            v.whole_multiple_of_period(
+                "simulation.output_interval_s",
+                sim.output_interval_s,
+                c.period_s,
+                false,
+            );
+        }
+        v.problems
+    }
+}
+
+/// `{}` of an f64 (shortest round-trip form; `40000` for 40000.0).
+fn num(x: f64) -> String {
+    format!("{x}")
+}
+
+#[derive(Default)]
+struct Validator {
+    problems: Vec<Problem>,
+}
+
+impl Validator {
+    /// Records a problem unless `ok`; returns `ok`.
+    fn check(&mut self, ok: bool, field: &str, value: String, message: &str) -> bool {
+        if !ok {
+            self.problems.push(Problem {
+                field: field.to_string(),
+                value,
+                message: message.to_string(),
+                from_override: false,
+            });
+        }
+        ok
+    }
+    fn finite(&mut self, field: &str, x: f64) -> bool {
+        self.check(x.is_finite(), field, num(x), "must be a finite number")
+    }
+    fn positive(&mut self, field: &str, x: f64) -> bool {
+        self.finite(field, x) && self.check(x > 0.0, field, num(x), "must be above 0")
+    }
+    fn non_negative(&mut self, field: &str, x: f64) -> bool {
+        self.finite(field, x) && self.check(x >= 0.0, field, num(x), "must not be negative")
+    }
+    fn angle_in_open_range(&mut self, field: &str, x: f64, (lo, hi): (f64, f64), range: &str) {
+        if self.finite(field, x) {
+            self.check(
+                x > lo && x < hi,
+                field,
+                num(x),
+                &format!("must be within {range}"),
+            );
+        }
+    }
+    /// `x` must be `k · period` for a whole k (k ≥ 1, or k ≥ 0 when `zero_ok`).
+    fn whole_multiple_of_period(&mut self, field: &str, x: f64, period: f64, zero_ok: bool) {
+        if !(period.is_finite() && period > 0.0) {
+            return; // reported on controller.period_s
+        }
+        let ratio = x / period;
+        let k = ratio.round();
+        let whole = (ratio - k).abs() <= WHOLE_MULTIPLE_REL_TOL * ratio.abs().max(1.0);
+        let ok = whole && (k >= 1.0 || (zero_ok && k == 0.0));
+        let what = if zero_ok { "non-negative" } else { "positive" };
+        self.check(
+            ok,
+            field,
+            num(x),
+            &format!(
+                "must be a {what} whole multiple of controller.period_s = {}",
+                num(period)
+            ),
+        );
+    }
+}
+
+// ---- schema: the keys and value types of `Scenario`, traced from its Deserialize impl -------
+
+/// The type a scenario key holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LeafKind {
+    /// A float (an integer is accepted and converted).
+    Float,
+    /// An integer within `[min, max]`.
+    Integer {
+        /// Smallest allowed value.
+        min: i64,
+        /// Largest allowed value.
+        max: i64,
+    },
+    /// A string.
+    String,
+    /// A boolean.
+    Bool,
+    /// One of the listed strings (an enum).
+    OneOf(&'static [&'static str]),
+}
+
+impl LeafKind {
+    fn describe(self) -> String {
+        match self {
+            LeafKind::Float => "must be a number".to_string(),
+            LeafKind::Integer { min, max } => format!("must be an integer in [{min}, {max}]"),
+            LeafKind::String => "must be a string".to_string(),
+            LeafKind::Bool => "must be true or false".to_string(),
+            LeafKind::OneOf(names) => format!("must be one of {}", names.join(", ")),
+        }
+    }
+
+    /// Does `value` fit? (Integers fit floats.)
+    fn accepts(self, value: &toml::Value) -> bool {
+        match (self, value) {
+            (LeafKind::Float, toml::Value::Float(_) | toml::Value::Integer(_)) => true,
+            (LeafKind::Integer { min, max }, toml::Value::Integer(i)) => (min..=max).contains(i),
+            (LeafKind::String, toml::Value::String(_)) => true,
+            (LeafKind::Bool, toml::Value::Boolean(_)) => true,
+            (LeafKind::OneOf(names), toml::Value::String(s)) => names.contains(&s.as_str()),
+            _ => false,
+        }
+    }
+}
+
+/// Every key of a scenario file: dotted leaf keys with their types, and the section tables.
+#[derive(Debug, Default)]
+pub struct Schema {
+    /// Dotted key → value type, e.g. `stage1.band_start_m` → `Float`.
+    pub leaves: BTreeMap<String, LeafKind>,
+    /// Dotted keys of the sections (tables), e.g. `stage1`.
+    pub tables: BTreeSet<String>,
+}
+
+impl Schema {
+    /// The keys directly under `prefix` ("" for the top level), comma-separated.
+    fn keys_under(&self, prefix: &str) -> String {
+        let under = |k: &&String| match prefix {
+            "" => !k.contains('.'),
+            p => k
+                .strip_prefix(p)
+                .and_then(|rest| rest.strip_prefix('.'))
+                .is_some_and(|rest| !rest.contains('.')),
+        };
+        let mut keys: Vec<&String> = self.leaves.keys().filter(under).collect();
+        keys.extend(self.tables.iter().filter(under));
+        keys.sort();
+        keys.iter()
+            .map(|k| k.rsplit('.').next().unwrap_or(k))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// The scenario's key schema (traced once from `Scenario`'s `Deserialize` impl, so it follows
+/// the structs automatically).
+pub fn schema() -> &'static Schema {
+    static SCHEMA: OnceLock<Schema> = OnceLock::new();
+    SCHEMA.get_or_init(|| {
+        let mut schema = Schema::default();
+        let tracer = Tracer {
+            path: String::new(),
+            out: &mut schema,
+        };
+        // The tracer feeds every field a placeholder, so this cannot fail for plain structs of
+        // numbers, strings, bools, options and unit enums; anything else is a programming error.
+        if let Err(e) = <Scenario as Deserialize>::deserialize(tracer) {
+            panic!("scenario schema tracing failed: {e}");
+        }
+        schema
+    })
+}
+
+struct Tracer<'a> {
+    path: String,
+    out: &'a mut Schema,
+}
+
+type TraceError = serde::de::value::Error;
+
+impl Tracer<'_> {
+    fn leaf(self, kind: LeafKind) {
+        self.out.leaves.insert(self.path, kind);
+    }
+    fn int(self, min: i64, max: i64) {
+        self.leaf(LeafKind::Integer { min, max });
+    }
+}
+
+impl<'de> serde::Deserializer<'de> for Tracer<'_> {
+    type Error = TraceError;
+
+    fn deserialize_any<V: serde::de::Visitor<'de>>(self, _: V) -> Result<V::Value, TraceError> {
+        Err(serde::de::Error::custom(format!(
+            "unsupported field type at `{}`",
+            self.path
+        )))
+    }
+    fn deserialize_f64<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, TraceError> {
+        self.leaf(LeafKind::Float);
+        v.visit_f64(0.0)
+    }
+    fn deserialize_f32<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, TraceError> {
+        self.leaf(LeafKind::Float);
+        v.visit_f32(0.0)
+    }
+    fn deserialize_u8<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, TraceError> {
+        self.int(0, u8::MAX.into());
+        v.visit_u8(1)
+    }
+    fn deserialize_u16<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, TraceError> {
+        self.int(0, u16::MAX.into());
+        v.visit_u16(1)
+    }
+    fn deserialize_u32<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, TraceError> {
+        self.int(0, u32::MAX.into());
+        v.visit_u32(1)
+    }
+    fn deserialize_u64<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, TraceError> {
+        self.int(0, i64::MAX);
+        v.visit_u64(1)
+    }
+    fn deserialize_i8<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, TraceError> {
+        self.int(i8::MIN.into(), i8::MAX.into());
+        v.visit_i8(1)
+    }
+    fn deserialize_i16<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, TraceError> {
+        self.int(i16::MIN.into(), i16::MAX.into());
+        v.visit_i16(1)
+    }
+    fn deserialize_i32<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, TraceError> {
+        self.int(i32::MIN.into(), i32::MAX.into());
+        v.visit_i32(1)
+    }
+    fn deserialize_i64<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, TraceError> {
+        self.int(i64::MIN, i64::MAX);
+        v.visit_i64(1)
+    }
+    fn deserialize_bool<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, TraceError> {
+        self.leaf(LeafKind::Bool);
+        v.visit_bool(false)
+    }
+    fn deserialize_str<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, TraceError> {
+        self.leaf(LeafKind::String);
+        v.visit_str("")
+    }
+    fn deserialize_string<V: serde::de::Visitor<'de>>(
+        self,
+        v: V,
+    ) -> Result<V::Value, TraceError> {
+        self.leaf(LeafKind::String);
+        v.visit_string(String::new())
+    }
+    fn deserialize_option<V: serde::de::Visitor<'de>>(
+        self,
+        v: V,
+    ) -> Result<V::Value, TraceError> {
+        v.visit_some(self)
+    }
+    fn deserialize_struct<V: serde::de::Visitor<'de>>(
+        self,
+        _name: &'static str,
+        fields: &'static [&'static str],
+        v: V,
+    ) -> Result<V::Value, TraceError> {
+        if !self.path.is_empty() {
+            self.out.tables.insert(self.path.clone());
+        }
+        v.visit_map(TraceFields {
+            path: self.path,
+            fields,
+            next: 0,
+            out: self.out,
+        })
+    }
+    fn deserialize_enum<V: serde::de::Visitor<'de>>(
+        self,
+        _name: &'static str,
+        variants: &'static [&'static str],
+        v: V,
+    ) -> Result<V::Value, TraceError> {
+        use serde::de::IntoDeserializer;
+        self.leaf(LeafKind::OneOf(variants));
+        let first: &'static str = variants.first().copied().unwrap_or("");
+        v.visit_enum(first.into_deserializer())
+    }
+
+    serde::forward_to_deserialize_any! {
+        i128 u128 char bytes byte_buf unit unit_struct newtype_struct seq tuple
+        tuple_struct map identifier ignored_any
+    }
+}
+
+struct TraceFields<'a> {
+    path: String,
+    fields: &'static [&'static str],
+    next: usize,
+    out: &'a mut Schema,
+}
+
+impl<'de> serde::de::MapAccess<'de> for TraceFields<'_> {
+    type Error = TraceError;
+
+    fn next_key_seed<K: serde::de::DeserializeSeed<'de>>(
+        &mut self,
+        seed: K,
+    ) -> Result<Option<K::Value>, TraceError> {
+        use serde::de::IntoDeserializer;
+        match self.fields.get(self.next) {
+            Some(&field) => seed.deserialize(field.into_deserializer()).map(Some),
+            None => Ok(None),
+        }
+    }
+
+    fn next_value_seed<V: serde::de::DeserializeSeed<'de>>(
+        &mut self,
+        seed: V,
+    ) -> Result<V::Value, TraceError> {
+        let field = self.fields.get(self.next).copied().unwrap_or("");
+        self.next += 1;
+        let path = if self.path.is_empty() {
+            field.to_string()
+        } else {
+            format!("{}.{field}", self.path)
+        };
+        seed.deserialize(Tracer {
+            path,
+            out: &mut *self.out,
+        })
+    }
+}
+
+// ---- checking the file's table and applying overrides ----------------------------------------
+
+fn join_key(prefix: &str, key: &str) -> String {
+    if prefix.is_empty() {
+        key.to_string()
+    } else {
+        format!("{prefix}.{key}")
+    }
+}
+
+fn hint_for(schema: &Schema, prefix: &str) -> String {
+    if prefix.is_empty() {
+        format!("top-level keys: {}", schema.keys_under(""))
+    } else if schema.tables.contains(prefix) {
+        format!("keys in [{prefix}]: {}", schema.keys_under(prefix))
+    } else {
+        format!("top-level keys: {}", schema.keys_under(""))
+    }
+}
+
+/// Checks every key of `table` (at dotted `prefix`) against the schema: unknown keys and values
+/// of the wrong type are errors.
+fn check_table(
+    table: &toml::Table,
+    prefix: &str,
+    schema: &Schema,
+    file: &str,
+    origin: &str,
+) -> Result<(), ScenarioError> {
+    for (key, value) in table {
+        let full = join_key(prefix, key);
+        if let Some(kind) = schema.leaves.get(&full) {
+            if !kind.accepts(value) {
+                return Err(ScenarioError::WrongType {
+                    file: file.to_string(),
+                    origin: origin.to_string(),
+                    key: full,
+                    value: value.to_string(),
+                    message: kind.describe(),
+                });
+            }
+        } else if schema.tables.contains(&full) {
+            match value {
+                toml::Value::Table(sub) => check_table(sub, &full, schema, file, origin)?,
+                other => {
+                    return Err(ScenarioError::WrongType {
+                        file: file.to_string(),
+                        origin: origin.to_string(),
+                        key: full.clone(),
+                        value: other.to_string(),
+                        message: format!("must be a table ([{full}])"),
+                    })
+                }
+            }
+        } else {
+            return Err(ScenarioError::UnknownKey {
+                file: file.to_string(),
+                origin: origin.to_string(),
+                key: full,
+                hint: hint_for(schema, prefix),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Parses the value of a `--set`: a TOML scalar (integer, float, bool, quoted string), or else the
+/// raw text as a string.
+fn parse_override_value(raw: &str) -> toml::Value {
+    let raw = raw.trim();
+    if let Ok(mut t) = toml::from_str::<toml::Table>(&format!("v = {raw}")) {
+        if t.len() == 1 {
+            if let Some(v) = t.remove("v") {
+                return v;
+            }
+        }
+    }
+    toml::Value::String(raw.to_string())
+}
+
+/// Applies one `key=value` override to `table`; returns the dotted key.
+fn apply_override(
+    table: &mut toml::Table,
+    arg: &str,
+    schema: &Schema,
+    file: &str,
+) -> Result<String, ScenarioError> {
+    let bad = |message: &str| ScenarioError::BadOverride {
+        file: file.to_string(),
+        arg: arg.to_string(),
+        message: message.to_string(),
+    };
+    let (key, raw) = arg
+        .split_once('=')
+        .ok_or_else(|| bad("expected key=value, e.g. tether.density_kg_per_m=1e-3"))?;
+    let key = key.trim();
+    if key.is_empty() || key.split('.').any(|part| part.trim().is_empty()) {
+        return Err(bad(
+            "the key must be a dotted path such as stage2.start_time_s",
+        ));
+    }
+    let origin = format!("--set {arg}: ");
+    let Some(&kind) = schema.leaves.get(key) else {
+        let prefix = key.rsplit_once('.').map_or("", |(p, _)| p);
+        let hint = if schema.tables.contains(key) {
+            format!(
+                "`{key}` is a section; set one of its keys: {}",
+                schema.keys_under(key)
+            )
+        } else {
+            hint_for(schema, prefix)
+        };
+        return Err(ScenarioError::UnknownKey {
+            file: file.to_string(),
+            origin,
+            key: key.to_string(),
+            hint,
+        });
+    };
+    let mut value = parse_override_value(raw);
+    value = match (kind, value) {
+        // A string field takes the text as written, whatever it looks like.
+        (LeafKind::String, toml::Value::String(s)) => toml::Value::String(s),
+        (LeafKind::String, _) => toml::Value::String(raw.trim().to_string()),
+        // An integer given for a float field is that float.
+        (LeafKind::Float, toml::Value::Integer(i)) => toml::Value::Float(i as f64),
+        (_, v) => v,
+    };
+    if !kind.accepts(&value) {
+        return Err(ScenarioError::WrongType {
+            file: file.to_string(),
+            origin,
+            key: key.to_string(),
+            value: value.to_string(),
+            message: kind.describe(),
+        });
+    }
+    let parts: Vec<&str> = key.split('.').collect();
+    let (last, sections) = parts.split_last().ok_or_else(|| bad("empty key"))?;
+    let mut cursor = table;
+    let mut walked = String::new();
+    for part in sections {
+        walked = join_key(&walked, part);
+        let entry = cursor
+            .entry(part.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        cursor = match entry {
+            toml::Value::Table(t) => t,
+            _ => return Err(bad(&format!("`{walked}` in the file is not a table"))),
+        };
+    }
+    cursor.insert(last.to_string(), value);
+    Ok(key.to_string())
+}
+
+/// Turns a deserialization error of the (already schema-checked) table into a clear message;
+/// in practice a missing required key.
+fn deserialize_error(
+    e: &toml::de::Error,
+    table: &toml::Table,
+    schema: &Schema,
+    file: &str,
+) -> ScenarioError {
+    let message = e.message();
+    if let Some(field) = message
+        .strip_prefix("missing field `")
+        .and_then(|rest| rest.split('`').next())
+    {
+        let absent = |k: &String| {
+            k.rsplit('.').next() == Some(field) && lookup(table, k).is_none() && {
+                // The enclosing section is present (or is the top level); otherwise the section
+                // itself is what is missing.
+                k.rsplit_once('.')
+                    .is_none_or(|(parent, _)| lookup(table, parent).is_some())
+            }
+        };
+        let candidate = schema
+            .leaves
+            .keys()
+            .chain(schema.tables.iter())
+            .find(|k| absent(k));
+        if let Some(key) = candidate {
+            return ScenarioError::MissingKey {
+                file: file.to_string(),
+                key: key.clone(),
+            };
+        }
+    }
+    ScenarioError::Deserialize {
+        file: file.to_string(),
+        message: e.to_string().trim_end().replace('\n', " "),
+    }
+}
+
+fn lookup<'t>(table: &'t toml::Table, dotted: &str) -> Option<&'t toml::Value> {
+    let mut parts = dotted.split('.');
+    let mut value = table.get(parts.next()?)?;
+    for part in parts {
+        value = value.as_table()?.get(part)?;
+    }
+    Some(value)
+}

@@ -1,0 +1,251 @@
+//! The closed loop: the `tss-reel` controller core (f32, exactly as on the target) flying the
+//! f64 plant of Eq. 5, synchronised on the control period.
+//!
+//! Each tick: the plant's state is sensed (rounded to f32), the controller steps, its rate
+//! command is held over the period (zero-order hold) while RK4 integrates the plant.
+
+use crate::history::{History, PhaseLabel, Sample};
+use crate::plant::{ix, Plant, State};
+use crate::scenario::Scenario;
+use tss_reel::controller::{
+    Config, ConfigError, Controller, Envelope, Input, Output, Phase, Stage1Config, Stage2Config,
+};
+use tss_reel::law::Gains;
+use tss_reel::mass::MassModel;
+use tss_reel::orbit::Orbit;
+use tss_reel::schedule::BandSchedule;
+use tss_reel::Real;
+
+/// Why a run could not be completed.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// The scenario's numbers do not make a valid controller.
+    #[error("controller configuration rejected: {0}")]
+    Config(ConfigError),
+    /// A timing field is not a whole number of control periods.
+    #[error("{field} = {value} s is not a whole number of control periods ({period_s} s)")]
+    Timing {
+        /// The scenario field.
+        field: &'static str,
+        /// Its value, s.
+        value: f64,
+        /// The control period, s.
+        period_s: f64,
+    },
+    /// The plant state stopped being finite (a physically impossible run).
+    #[error("the plant state became non-finite at t = {t_s} s")]
+    Diverged {
+        /// Mission time, s.
+        t_s: f64,
+    },
+}
+
+/// The controller configuration a scenario describes, in the controller's scalar type.
+pub fn controller_config<T: Real>(sc: &Scenario) -> Result<Config<T>, SimError> {
+    let f = T::from_f64;
+    let period = sc.controller.period_s;
+    let stage2_tick = ticks("stage2.start_time_s", sc.stage2.start_time_s, period)?;
+    Ok(Config {
+        period_s: f(period),
+        masses: mass_model(sc),
+        gains: Gains {
+            k1_per_s: f(sc.controller.k1_per_s),
+            k2_per_s2: f(sc.controller.k2_per_s2),
+        },
+        initial_rate_mps: f(sc.initial.length_rate_mps),
+        stage1: Stage1Config {
+            schedule: BandSchedule {
+                low_length_m: f(sc.stage1.band_start_m),
+                low_angle_rad: f(sc.stage1.deploy_angle_rad),
+                low_slope_rad_per_m: T::ZERO,
+                high_length_m: f(sc.stage1.keep_length_m),
+                high_angle_rad: T::ZERO,
+                high_slope_rad_per_m: f(sc.stage1.keep_slope_rad_per_m),
+            },
+            decay_rate_per_s: f(sc.stage1.decay_rate_per_s),
+        },
+        stage2: Stage2Config {
+            schedule: BandSchedule {
+                low_length_m: f(sc.stage2.keep_length_m),
+                low_angle_rad: T::ZERO,
+                low_slope_rad_per_m: f(sc.stage2.keep_slope_rad_per_m),
+                high_length_m: f(sc.stage2.band_start_m),
+                high_angle_rad: f(sc.stage2.retrieve_angle_rad),
+                high_slope_rad_per_m: T::ZERO,
+            },
+            slew_rate_radps: f(sc.stage2.slew_rate_radps),
+            decay_rate_per_s: f(sc.stage2.decay_rate_per_s),
+            start_tick: Some(stage2_tick),
+        },
+        keep_capture_m: f(sc.controller.keep_capture_m),
+        envelope: Envelope {
+            max_rate_mps: f(sc.envelope.max_rate_mps),
+            max_accel_mps2: f(sc.envelope.max_accel_mps2),
+            min_length_m: f(sc.envelope.min_length_m),
+            max_length_m: f(sc.envelope.max_length_m),
+        },
+    })
+}
+
+fn mass_model<T: Real>(sc: &Scenario) -> MassModel<T> {
+    MassModel {
+        main_initial_kg: T::from_f64(sc.masses.main_initial_kg),
+        sub_kg: T::from_f64(sc.masses.sub_kg),
+        tether_density_kg_per_m: T::from_f64(sc.tether.density_kg_per_m),
+    }
+}
+
+/// The plant a scenario describes.
+pub fn plant(sc: &Scenario) -> Plant {
+    Plant {
+        orbit: Orbit::elliptic(sc.orbit.semi_major_axis_m, sc.orbit.eccentricity),
+        masses: mass_model(sc),
+    }
+}
+
+/// `value_s` as a whole number of periods (to 1e-9 relative), or a [`SimError::Timing`].
+fn ticks(field: &'static str, value_s: f64, period_s: f64) -> Result<u32, SimError> {
+    let n = (value_s / period_s).round();
+    let ok = n >= 0.0 && n <= f64::from(u32::MAX) && (n * period_s - value_s).abs() <= 1e-9 * value_s.abs().max(period_s);
+    if ok {
+        Ok(n as u32)
+    } else {
+        Err(SimError::Timing {
+            field,
+            value: value_s,
+            period_s,
+        })
+    }
+}
+
+/// The initial plant state: l(0), α(0) = α_r(l0) + δ(0), α̇(0) = δ̇(0) + (∂α_r/∂l) l̇0, β, β̇,
+/// with α_r the stage-1 schedule of `cfg`.
+pub fn initial_state<T: Real>(sc: &Scenario, cfg: &Config<T>) -> State {
+    let s = &cfg.stage1.schedule;
+    let schedule = BandSchedule::<f64> {
+        low_length_m: s.low_length_m.to_f64(),
+        low_angle_rad: s.low_angle_rad.to_f64(),
+        low_slope_rad_per_m: s.low_slope_rad_per_m.to_f64(),
+        high_length_m: s.high_length_m.to_f64(),
+        high_angle_rad: s.high_angle_rad.to_f64(),
+        high_slope_rad_per_m: s.high_slope_rad_per_m.to_f64(),
+    };
+    let r = schedule.eval(sc.initial.length_m);
+    State::from([
+        sc.orbit.initial_true_anomaly_rad,
+        sc.initial.length_m,
+        r.angle_rad + sc.initial.delta_rad,
+        sc.initial.delta_rate_radps + r.slope_rad_per_m * sc.initial.length_rate_mps,
+        sc.initial.beta_rad,
+        sc.initial.beta_rate_radps,
+    ])
+}
+
+/// Runs the scenario with the flight controller (f32) in the loop.
+///
+/// `probe_times_s` are instants (whole control periods) at which the length is recorded in
+/// [`History::probes`]; `progress` is called with the mission time every simulated minute.
+pub fn run(
+    sc: &Scenario,
+    probe_times_s: &[f64],
+    progress: &mut dyn FnMut(f64),
+) -> Result<History, SimError> {
+    run_with::<f32>(sc, probe_times_s, progress)
+}
+
+/// Runs the scenario with the controller evaluated in scalar type `T` (f32 is the flight
+/// build; f64 evaluates the same law in double precision, for accuracy studies).
+pub fn run_with<T: Real>(
+    sc: &Scenario,
+    probe_times_s: &[f64],
+    progress: &mut dyn FnMut(f64),
+) -> Result<History, SimError> {
+    let period = sc.controller.period_s;
+    let cfg = controller_config::<T>(sc)?;
+    let mut x = initial_state(sc, &cfg);
+    let mut ctl = Controller::new(cfg).map_err(SimError::Config)?;
+    let plant = plant(sc);
+    let total = ticks("simulation.duration_s", sc.simulation.duration_s, period)?;
+    let every = ticks("simulation.output_interval_s", sc.simulation.output_interval_s, period)?.max(1);
+    let mut probes: Vec<(u32, f64)> = Vec::with_capacity(probe_times_s.len());
+    for &t in probe_times_s {
+        probes.push((ticks("probe time", t, period)?, t));
+    }
+    let substeps = sc.simulation.substeps.max(1);
+    let h = period / f64::from(substeps);
+    let progress_every = ticks("progress", 60.0, period).unwrap_or(60).max(1);
+
+    let mut history = History {
+        samples: Vec::with_capacity((total / every) as usize + 2),
+        probes: Vec::with_capacity(probes.len()),
+    };
+    let mut next_probe = 0;
+    for tick in 0..=total {
+        let t_s = f64::from(tick) * period;
+        if !x.iter().all(|v| v.is_finite()) {
+            return Err(SimError::Diverged { t_s });
+        }
+        let theta = x[ix::THETA];
+        let input = Input {
+            tick,
+            length_m: T::from_f64(x[ix::LENGTH]),
+            alpha_rad: T::from_f64(x[ix::ALPHA]),
+            alpha_rate_radps: T::from_f64(x[ix::ALPHA_RATE]),
+            orbit_rate_radps: T::from_f64(plant.orbit.true_anomaly_rate_radps(theta)),
+        };
+        let out = ctl.step(&input);
+        let rate = out.rate_cmd_mps.to_f64();
+        while next_probe < probes.len() && probes[next_probe].0 <= tick {
+            if probes[next_probe].0 == tick {
+                history.probes.push((probes[next_probe].1, x[ix::LENGTH]));
+            }
+            next_probe += 1;
+        }
+        if tick % every == 0 || tick == total {
+            history.samples.push(sample(&plant, &x, t_s, &out));
+        }
+        if tick % progress_every == 0 {
+            progress(t_s);
+        }
+        if tick == total {
+            break;
+        }
+        for _ in 0..substeps {
+            x = plant.rk4_step(&x, rate, h);
+        }
+    }
+    Ok(history)
+}
+
+fn sample<T: Real>(plant: &Plant, x: &State, t_s: f64, out: &Output<T>) -> Sample {
+    let rate = out.rate_cmd_mps.to_f64();
+    let accel = out.accel_cmd_mps2.to_f64();
+    Sample {
+        t_s,
+        length_m: x[ix::LENGTH],
+        length_rate_mps: rate,
+        alpha_rad: x[ix::ALPHA],
+        alpha_rate_radps: x[ix::ALPHA_RATE],
+        alpha_ref_rad: out.alpha_ref_rad.to_f64(),
+        delta_rad: out.delta_rad.to_f64(),
+        delta_rate_radps: out.delta_rate_radps.to_f64(),
+        beta_rad: x[ix::BETA],
+        tension_n: plant.tension_n(x, rate, accel),
+        length_accel_mps2: accel,
+        law_rate_mps: out.law_rate_mps.to_f64(),
+        blend_weight: out.blend_weight.to_f64(),
+        phase: phase_label(out.phase),
+        flags: out.flags.0,
+    }
+}
+
+/// The history label of a controller phase.
+pub fn phase_label(p: Phase) -> PhaseLabel {
+    match p {
+        Phase::Deploy => PhaseLabel::Deploy,
+        Phase::Keep1 => PhaseLabel::Keep1,
+        Phase::Slew => PhaseLabel::Slew,
+        Phase::Retrieve => PhaseLabel::Retrieve,
+        Phase::Keep2 => PhaseLabel::Keep2,
+    }
+}

@@ -1,0 +1,384 @@
+//! The range-rate control law (Eqs. 26–30, SPEC §5): circular orbit, in-plane (β = 0).
+//!
+//! With δ = α − α_r, the paper's law (Eq. 27)
+//!
+//! ```text
+//!   l̇ = [k1 δ̇ + k2 δ − 1.5 n² sin(2δ + 2α_r)] / (n + δ̇) · l/(2 + μ3)
+//! ```
+//!
+//! turns the in-plane equation (26) into the linear δ̈ + k1 δ̇ + k2 δ = −α̈_r − (2+μ3) α̇_r l̇/l
+//! (Eq. 28), and the decay blend (Eq. 29) joins it to the reel's initial rate:
+//! l̇_real = l̇ + (l̇0 − l̇) e^{−cτ}.
+//!
+//! **Eq. 27 is implicit** when α_r depends on l: α̇_r = p·l̇_real + r (p = ∂α_r/∂l,
+//! r = ∂α_r/∂t), so δ̇ contains the rate being computed. [`solve`] solves Eqs. 27 + 29 exactly
+//! for y = l̇_real as the root of (SPEC §5)
+//!
+//! ```text
+//!   (y − E l̇0)(w − p y) = (1 − E) L′ (G0 − k1 p y),
+//!   w = n + α̇ − r,  G0 = k1(α̇ − r) + k2 δ − 1.5 n² sin 2α,  L′ = l/(2+μ3),  E = e^{−cτ},
+//! ```
+//!
+//! taking the physical root y = 2C/(b + √(b² − 4pC)), the one that tends to C/b as p → 0.
+
+use crate::real::Real;
+
+/// The gains of Eq. 27.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gains<T> {
+    /// k1, 1/s: the damping gain of Eq. 28 (= 2ζω0).
+    pub k1_per_s: T,
+    /// k2, 1/s²: the stiffness gain of Eq. 28 (= ω0²).
+    pub k2_per_s2: T,
+}
+
+impl<T: Real> Gains<T> {
+    /// The paper's gains (Section 6): k1 = 0.0057 s⁻¹, k2 = 9.8696e-6 s⁻²
+    /// (ω0 = π·10⁻³ rad/s, ζ ≈ 0.91).
+    pub fn paper() -> Self {
+        Self {
+            k1_per_s: T::from_f64(0.0057),
+            k2_per_s2: T::from_f64(9.8696e-6),
+        }
+    }
+}
+
+/// Everything the law needs at one instant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LawInput<T> {
+    /// Tether length l, m.
+    pub length_m: T,
+    /// In-plane angle α, rad.
+    pub alpha_rad: T,
+    /// In-plane rate α̇, rad/s.
+    pub alpha_rate_radps: T,
+    /// Orbit rate n, rad/s.
+    pub orbit_rate_radps: T,
+    /// α_r, rad.
+    pub ref_angle_rad: T,
+    /// p = ∂α_r/∂l, rad/m.
+    pub ref_slope_rad_per_m: T,
+    /// ∂²α_r/∂l², rad/m².
+    pub ref_curvature_rad_per_m2: T,
+    /// r = ∂α_r/∂t, rad/s.
+    pub ref_time_rate_radps: T,
+    /// μ3 at this length (Eq. 5).
+    pub mu3: T,
+    /// μ̇3 per unit reel rate, i.e. dμ3/dl, 1/m (so that μ̇3 = dμ3/dl · l̇).
+    pub mu3_per_m: T,
+    /// E = e^{−cτ}, the Eq. 29 blend weight, in [0, 1].
+    pub blend_weight: T,
+    /// c, the Eq. 29 decay rate, 1/s.
+    pub decay_rate_per_s: T,
+    /// l̇0, the rate the current stage's blend started from, m/s.
+    pub initial_rate_mps: T,
+    /// The gains.
+    pub gains: Gains<T>,
+}
+
+/// Why the law has no valid solution at this instant (SPEC §5, the law's singular points).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum LawFault {
+    /// b ≤ 0 in the implicit solve: n + δ̇ has reached zero (the Eq. 27 denominator) or
+    /// changed sign, so the command would be unbounded or the wrong root.
+    SingularDenominator,
+    /// b² − 4pC < 0: Eqs. 27 + 29 have no real solution for this state.
+    NoRealSolution,
+    /// 1 + B·p ≈ 0 in the acceleration solve: the rate solution is at a fold.
+    AccelerationSingular,
+    /// An intermediate value was not finite (input out of any physical range).
+    NotFinite,
+}
+
+/// The law's solution at one instant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LawOutput<T> {
+    /// y = l̇_real, the blended reel-rate command (Eq. 29), m/s.
+    pub rate_mps: T,
+    /// The Eq. 27 value l̇ (before the blend), m/s.
+    pub law_rate_mps: T,
+    /// δ = α − α_r, rad.
+    pub delta_rad: T,
+    /// δ̇ = α̇ − α̇_r with α̇_r = p·y + r (consistent with the command), rad/s.
+    pub delta_rate_radps: T,
+    /// α̇_r = p·y + r, rad/s.
+    pub ref_rate_radps: T,
+    /// n + δ̇, the Eq. 27 denominator, rad/s.
+    pub denominator_radps: T,
+}
+
+/// Smallest admissible value of b relative to n: below this the Eq. 27 denominator n + δ̇ is
+/// treated as singular. In the paper's run (n + δ̇)/n falls to about 0.06 in the first minutes
+/// (SPEC §5), so 1 % leaves a factor-six margin while bounding the command's sensitivity.
+pub const MIN_DENOMINATOR_FRACTION: f64 = 0.01;
+
+/// Solves Eqs. 27 + 29 for the reel-rate command y = l̇_real (SPEC §5).
+///
+/// Returns a [`LawFault`] (never a non-finite number) at the law's singular points.
+pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
+    let two = T::from_f64(2.0);
+    let four = T::from_f64(4.0);
+    let three_halves = T::from_f64(1.5);
+    let n = x.orbit_rate_radps;
+    let p = x.ref_slope_rad_per_m;
+    let e = x.blend_weight;
+    let k1 = x.gains.k1_per_s;
+    let l_prime = x.length_m / (two + x.mu3);
+    let delta = x.alpha_rad - x.ref_angle_rad;
+    // sin(2δ + 2α_r) = sin 2α.
+    let gravity = three_halves * n * n * (two * x.alpha_rad).sin();
+    let w = n + x.alpha_rate_radps - x.ref_time_rate_radps;
+    let g0 =
+        k1 * (x.alpha_rate_radps - x.ref_time_rate_radps) + x.gains.k2_per_s2 * delta - gravity;
+    let b = w + p * (e * x.initial_rate_mps + (T::ONE - e) * l_prime * k1);
+    let c = e * x.initial_rate_mps * w + (T::ONE - e) * l_prime * g0;
+    if !(b.is_finite() && c.is_finite()) {
+        return Err(LawFault::NotFinite);
+    }
+    if b <= T::from_f64(MIN_DENOMINATOR_FRACTION) * n.abs() {
+        return Err(LawFault::SingularDenominator);
+    }
+    let disc = b * b - four * p * c;
+    if disc < T::ZERO {
+        return Err(LawFault::NoRealSolution);
+    }
+    let y = two * c / (b + disc.sqrt());
+    let ref_rate = p * y + x.ref_time_rate_radps;
+    let delta_rate = x.alpha_rate_radps - ref_rate;
+    let denom = n + delta_rate;
+    if denom <= T::from_f64(MIN_DENOMINATOR_FRACTION) * n.abs() {
+        return Err(LawFault::SingularDenominator);
+    }
+    // Eq. 27 itself, evaluated with the consistent δ̇.
+    let law_rate = (k1 * delta_rate + x.gains.k2_per_s2 * delta - gravity) / denom * l_prime;
+    if !(y.is_finite() && law_rate.is_finite()) {
+        return Err(LawFault::NotFinite);
+    }
+    Ok(LawOutput {
+        rate_mps: y,
+        law_rate_mps: law_rate,
+        delta_rad: delta,
+        delta_rate_radps: delta_rate,
+        ref_rate_radps: ref_rate,
+        denominator_radps: denom,
+    })
+}
+
+/// The commanded reel acceleration ÿ = d(l̇_real)/dt, the time derivative of Eq. 29 with
+/// Eq. 27 inside it (Eq. 30, with the sign of its `[(1−e^{−cτ}) l̇_real + c l e^{−cτ}] l̇/l`
+/// term corrected, SPEC §9.3).
+///
+/// δ̈ comes from the in-plane dynamics (Eq. 26 / 5b, circular orbit, β = 0) with l̇ = y, and
+/// α̈_r = (∂²α_r/∂l²) y² + p ÿ, which makes the result implicit again but linear in ÿ:
+/// ÿ = A / (1 + B p).
+pub fn acceleration<T: Real>(x: &LawInput<T>, s: &LawOutput<T>) -> Result<T, LawFault> {
+    let two = T::from_f64(2.0);
+    let three = T::from_f64(3.0);
+    let n = x.orbit_rate_radps;
+    let e = x.blend_weight;
+    let y = s.rate_mps;
+    let u = s.law_rate_mps;
+    let l = x.length_m;
+    let two_mu3 = two + x.mu3;
+    let l_prime = l / two_mu3;
+    let d = s.denominator_radps;
+    let mu3_dot = x.mu3_per_m * y;
+    // Eq. 5b (circular, β = 0) with l̇ = y.
+    let alpha_accel = -(n + x.alpha_rate_radps) * two_mu3 * y / l
+        - T::from_f64(1.5) * n * n * (two * x.alpha_rad).sin();
+    // u̇ = (L′/D)[(k1 − N/D) δ̈ + k2 δ̇ − 3n² α̇ cos2α] + u (y/l − μ̇3/(2+μ3)),  N/D = u/L′.
+    let k_eff = x.gains.k1_per_s - u / l_prime;
+    let b_coef = (T::ONE - e) * l_prime / d * k_eff;
+    let rest = l_prime / d
+        * (x.gains.k2_per_s2 * s.delta_rate_radps
+            - three * n * n * x.alpha_rate_radps * (two * x.alpha_rad).cos())
+        + u * (y / l - mu3_dot / two_mu3);
+    let a = x.decay_rate_per_s * e * (u - x.initial_rate_mps)
+        + (T::ONE - e) * rest
+        + b_coef * (alpha_accel - x.ref_curvature_rad_per_m2 * y * y);
+    let fold = T::ONE + b_coef * x.ref_slope_rad_per_m;
+    if fold.abs() < T::from_f64(1e-3) {
+        return Err(LawFault::AccelerationSingular);
+    }
+    let accel = a / fold;
+    if accel.is_finite() {
+        Ok(accel)
+    } else {
+        Err(LawFault::NotFinite)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const N: f64 = 1.060_237_230_236_363_5e-3;
+
+    fn base() -> LawInput<f64> {
+        LawInput {
+            length_m: 15_000.0,
+            alpha_rad: -0.6,
+            alpha_rate_radps: 1.0e-4,
+            orbit_rate_radps: N,
+            ref_angle_rad: -0.55,
+            ref_slope_rad_per_m: 6.0e-5,
+            ref_curvature_rad_per_m2: 3.0e-9,
+            ref_time_rate_radps: 0.0,
+            mu3: 0.0,
+            mu3_per_m: 0.0,
+            blend_weight: 0.2,
+            decay_rate_per_s: 1e-3,
+            initial_rate_mps: 0.1,
+            gains: Gains::paper(),
+        }
+    }
+
+    /// Eq. 27 evaluated directly, for a given δ̇.
+    fn eq27(x: &LawInput<f64>, delta_rate: f64) -> f64 {
+        let delta = x.alpha_rad - x.ref_angle_rad;
+        let n = x.orbit_rate_radps;
+        (x.gains.k1_per_s * delta_rate + x.gains.k2_per_s2 * delta
+            - 1.5 * n * n * (2.0 * delta + 2.0 * x.ref_angle_rad).sin())
+            / (n + delta_rate)
+            * x.length_m
+            / (2.0 + x.mu3)
+    }
+
+    #[test]
+    fn implicit_solution_has_zero_residual() {
+        let x = base();
+        let s = solve(&x).unwrap();
+        // Substituting y back: δ̇ = α̇ − (p y + r), then Eq. 29 must return y.
+        let dd = x.alpha_rate_radps - (x.ref_slope_rad_per_m * s.rate_mps + x.ref_time_rate_radps);
+        let blended = eq27(&x, dd) + (x.initial_rate_mps - eq27(&x, dd)) * x.blend_weight;
+        assert!((blended - s.rate_mps).abs() < 1e-12 * s.rate_mps.abs().max(1.0));
+        assert!((s.law_rate_mps - eq27(&x, dd)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn without_slope_it_is_the_explicit_law() {
+        let x = LawInput {
+            ref_slope_rad_per_m: 0.0,
+            ..base()
+        };
+        let s = solve(&x).unwrap();
+        let dd = x.alpha_rate_radps;
+        let u = eq27(&x, dd);
+        let expect = u + (x.initial_rate_mps - u) * x.blend_weight;
+        assert!((s.rate_mps - expect).abs() < 1e-14);
+    }
+
+    #[test]
+    fn at_stage_start_the_command_is_the_initial_rate() {
+        let x = LawInput {
+            blend_weight: 1.0,
+            ..base()
+        };
+        let s = solve(&x).unwrap();
+        assert!((s.rate_mps - 0.1).abs() < 1e-15);
+    }
+
+    #[test]
+    fn hand_value_on_the_deploy_plateau() {
+        // p = 0, E = 0, μ3 = 0, δ̇ = α̇: l̇ = [k1 α̇ + k2 δ − 1.5 n² sin 2α] / (n + α̇) · l/2.
+        let x = LawInput {
+            length_m: 2_000.0,
+            alpha_rad: -0.7,
+            alpha_rate_radps: 0.0,
+            ref_angle_rad: -core::f64::consts::FRAC_PI_4,
+            ref_slope_rad_per_m: 0.0,
+            ref_curvature_rad_per_m2: 0.0,
+            blend_weight: 0.0,
+            ..base()
+        };
+        let s = solve(&x).unwrap();
+        let delta = -0.7 + core::f64::consts::FRAC_PI_4;
+        let expect = (9.8696e-6 * delta - 1.5 * N * N * (-1.4_f64).sin()) / N * 1_000.0;
+        assert!(
+            (s.rate_mps - expect).abs() < 1e-12,
+            "{} vs {expect}",
+            s.rate_mps
+        );
+        assert!(expect > 0.0, "deploying on the −45° side");
+    }
+
+    #[test]
+    fn closed_loop_identity_eq28() {
+        // With E = 0, substituting l̇ from Eq. 27 into Eq. 26 gives
+        // δ̈ + k1 δ̇ + k2 δ = −α̈_r − (2+μ3) α̇_r l̇/l  (Eq. 28).
+        let x = LawInput {
+            blend_weight: 0.0,
+            mu3: 0.07,
+            ref_time_rate_radps: 2e-5,
+            ..base()
+        };
+        let s = solve(&x).unwrap();
+        let (n, y, l) = (x.orbit_rate_radps, s.rate_mps, x.length_m);
+        let alpha_ddot = -(n + x.alpha_rate_radps) * (2.0 + x.mu3) * y / l
+            - 1.5 * n * n * (2.0 * x.alpha_rad).sin();
+        // Eq. 26 rearranged: δ̈ = α̈ − α̈_r; the identity holds for any α̈_r, take α̈_r = 0.
+        let lhs =
+            alpha_ddot + x.gains.k1_per_s * s.delta_rate_radps + x.gains.k2_per_s2 * s.delta_rad;
+        let rhs = -(2.0 + x.mu3) * s.ref_rate_radps * y / l;
+        assert!((lhs - rhs).abs() < 1e-15, "{lhs} vs {rhs}");
+    }
+
+    #[test]
+    fn acceleration_is_the_time_derivative_of_the_command() {
+        // Advance the state along the model with l̇ = y, ref following the schedule-like
+        // linearisation α_r(l + dl) ≈ α_r + p dl + ½ q dl², and difference the command.
+        let x0 = LawInput {
+            mu3: 0.05,
+            mu3_per_m: 2.0e-6,
+            ..base()
+        };
+        let s0 = solve(&x0).unwrap();
+        let a0 = acceleration(&x0, &s0).unwrap();
+        let n = x0.orbit_rate_radps;
+        let dt = 1e-3;
+        let step = |h: f64| {
+            let y = s0.rate_mps;
+            let dl = y * h;
+            let alpha_ddot = -(n + x0.alpha_rate_radps) * (2.0 + x0.mu3) * y / x0.length_m
+                - 1.5 * n * n * (2.0 * x0.alpha_rad).sin();
+            let x = LawInput {
+                length_m: x0.length_m + dl,
+                alpha_rad: x0.alpha_rad + x0.alpha_rate_radps * h,
+                alpha_rate_radps: x0.alpha_rate_radps + alpha_ddot * h,
+                ref_angle_rad: x0.ref_angle_rad
+                    + x0.ref_slope_rad_per_m * dl
+                    + 0.5 * x0.ref_curvature_rad_per_m2 * dl * dl,
+                ref_slope_rad_per_m: x0.ref_slope_rad_per_m + x0.ref_curvature_rad_per_m2 * dl,
+                mu3: x0.mu3 + x0.mu3_per_m * dl,
+                blend_weight: x0.blend_weight * (-x0.decay_rate_per_s * h).exp(),
+                ..x0
+            };
+            solve(&x).unwrap().rate_mps
+        };
+        let fd = (step(dt) - step(-dt)) / (2.0 * dt);
+        assert!((a0 - fd).abs() < 1e-6 * fd.abs() + 1e-12, "{a0} vs {fd}");
+    }
+
+    #[test]
+    fn singular_denominator_is_a_fault_not_a_number() {
+        // On a plateau (p = 0) the denominator n + δ̇ = n + α̇ vanishes at α̇ = −n.
+        let x = LawInput {
+            alpha_rate_radps: -N,
+            ref_slope_rad_per_m: 0.0,
+            ..base()
+        };
+        assert_eq!(solve(&x), Err(LawFault::SingularDenominator));
+        let x = LawInput {
+            alpha_rate_radps: -1.5 * N,
+            ref_slope_rad_per_m: 0.0,
+            ..base()
+        };
+        assert_eq!(solve(&x), Err(LawFault::SingularDenominator));
+        let x = LawInput {
+            alpha_rate_radps: f64::NAN,
+            ..base()
+        };
+        assert_eq!(solve(&x), Err(LawFault::NotFinite));
+    }
+}

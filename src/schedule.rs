@@ -1,0 +1,314 @@
+//! Reference-angle schedules α_r(l) of Eqs. 34 and 35, with quintic Hermite transitions
+//! (SPEC §6), and the stage-2 slew.
+//!
+//! Both of the paper's schedules have the same shape: a straight piece below a transition band,
+//! a straight piece above it, and a transition function f(l) inside it whose value, slope and
+//! curvature match the neighbouring pieces at both ends (f″ = 0 there). [`BandSchedule`]
+//! describes that shape once:
+//!
+//! ```text
+//!   α_r(l) = low_angle  + low_slope  · (l − low_length)     l ≤ low_length
+//!          = quintic Hermite f(l)                           low_length < l < high_length
+//!          = high_angle + high_slope · (l − high_length)    l ≥ high_length
+//! ```
+//!
+//! Eq. 34 (stage 1) is `low = (10 km, −π/4, 0)`, `high = (30 km, 0, π·10⁻⁵)`;
+//! Eq. 35 (stage 2) is `low = (2 km, 0, 5π·10⁻⁵)`, `high = (5 km, π/10, 0)`.
+
+use crate::real::Real;
+
+/// α_r and its first two derivatives with respect to tether length.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RefAngle<T> {
+    /// α_r, rad.
+    pub angle_rad: T,
+    /// ∂α_r/∂l, rad/m (the `p` of SPEC §5).
+    pub slope_rad_per_m: T,
+    /// ∂²α_r/∂l², rad/m² (needed by the Eq. 30 acceleration).
+    pub curvature_rad_per_m2: T,
+}
+
+/// A reference-angle schedule of the Eq. 34 / Eq. 35 shape (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BandSchedule<T> {
+    /// Lower end of the transition band, m.
+    pub low_length_m: T,
+    /// α_r at the lower end, rad.
+    pub low_angle_rad: T,
+    /// Slope of the straight piece below the band, rad/m.
+    pub low_slope_rad_per_m: T,
+    /// Upper end of the transition band, m.
+    pub high_length_m: T,
+    /// α_r at the upper end, rad.
+    pub high_angle_rad: T,
+    /// Slope of the straight piece above the band, rad/m.
+    pub high_slope_rad_per_m: T,
+}
+
+/// Quintic Hermite basis at s ∈ [0, 1]: values, first and second derivatives of
+/// (H0, H1, H4, H5) (SPEC §6). H0/H5 carry the end values, H1/H4 the end slopes; all
+/// second derivatives vanish at both ends.
+struct Hermite5<T> {
+    h: [T; 4],
+    d1: [T; 4],
+    d2: [T; 4],
+}
+
+impl<T: Real> Hermite5<T> {
+    fn at(s: T) -> Self {
+        let c = |x: f64| T::from_f64(x);
+        let s2 = s * s;
+        let s3 = s2 * s;
+        let s4 = s3 * s;
+        let s5 = s4 * s;
+        Self {
+            h: [
+                T::ONE - c(10.0) * s3 + c(15.0) * s4 - c(6.0) * s5,
+                s - c(6.0) * s3 + c(8.0) * s4 - c(3.0) * s5,
+                -c(4.0) * s3 + c(7.0) * s4 - c(3.0) * s5,
+                c(10.0) * s3 - c(15.0) * s4 + c(6.0) * s5,
+            ],
+            d1: [
+                -c(30.0) * s2 + c(60.0) * s3 - c(30.0) * s4,
+                T::ONE - c(18.0) * s2 + c(32.0) * s3 - c(15.0) * s4,
+                -c(12.0) * s2 + c(28.0) * s3 - c(15.0) * s4,
+                c(30.0) * s2 - c(60.0) * s3 + c(30.0) * s4,
+            ],
+            d2: [
+                -c(60.0) * s + c(180.0) * s2 - c(120.0) * s3,
+                -c(36.0) * s + c(96.0) * s2 - c(60.0) * s3,
+                -c(24.0) * s + c(84.0) * s2 - c(60.0) * s3,
+                c(60.0) * s - c(180.0) * s2 + c(120.0) * s3,
+            ],
+        }
+    }
+}
+
+impl<T: Real> BandSchedule<T> {
+    /// Eq. 34 with the paper's numbers: −π/4 up to 10 km, a transition to 0 at 30 km, then
+    /// k(l − 30 km) with k = π·10⁻⁵ rad/m.
+    pub fn paper_stage1() -> Self {
+        Self {
+            low_length_m: T::from_f64(10_000.0),
+            low_angle_rad: T::from_f64(-core::f64::consts::FRAC_PI_4),
+            low_slope_rad_per_m: T::ZERO,
+            high_length_m: T::from_f64(30_000.0),
+            high_angle_rad: T::ZERO,
+            high_slope_rad_per_m: T::from_f64(core::f64::consts::PI * 1e-5),
+        }
+    }
+
+    /// Eq. 35 with the paper's numbers: k(l − 2 km) with k = 5π·10⁻⁵ rad/m up to 2 km, a
+    /// transition to π/10 at 5 km, then π/10.
+    pub fn paper_stage2() -> Self {
+        Self {
+            low_length_m: T::from_f64(2_000.0),
+            low_angle_rad: T::ZERO,
+            low_slope_rad_per_m: T::from_f64(5.0 * core::f64::consts::PI * 1e-5),
+            high_length_m: T::from_f64(5_000.0),
+            high_angle_rad: T::from_f64(core::f64::consts::PI / 10.0),
+            high_slope_rad_per_m: T::ZERO,
+        }
+    }
+
+    /// α_r(l), ∂α_r/∂l and ∂²α_r/∂l² at tether length `length_m` (Eqs. 34/35).
+    ///
+    /// Total for every input: a NaN length yields NaN outputs, which the controller's input
+    /// validation rejects before calling this.
+    pub fn eval(&self, length_m: T) -> RefAngle<T> {
+        if length_m <= self.low_length_m {
+            return RefAngle {
+                angle_rad: self.low_angle_rad
+                    + self.low_slope_rad_per_m * (length_m - self.low_length_m),
+                slope_rad_per_m: self.low_slope_rad_per_m,
+                curvature_rad_per_m2: T::ZERO,
+            };
+        }
+        if length_m >= self.high_length_m {
+            return RefAngle {
+                angle_rad: self.high_angle_rad
+                    + self.high_slope_rad_per_m * (length_m - self.high_length_m),
+                slope_rad_per_m: self.high_slope_rad_per_m,
+                curvature_rad_per_m2: T::ZERO,
+            };
+        }
+        // Transition band: f = f_a H0 + h f'_a H1 + h f'_b H4 + f_b H5 (SPEC §6).
+        let h = self.high_length_m - self.low_length_m;
+        let s = (length_m - self.low_length_m) / h;
+        let b = Hermite5::at(s);
+        let coef = [
+            self.low_angle_rad,
+            h * self.low_slope_rad_per_m,
+            h * self.high_slope_rad_per_m,
+            self.high_angle_rad,
+        ];
+        let dot = |w: &[T; 4]| coef[0] * w[0] + coef[1] * w[1] + coef[2] * w[2] + coef[3] * w[3];
+        RefAngle {
+            angle_rad: dot(&b.h),
+            slope_rad_per_m: dot(&b.d1) / h,
+            curvature_rad_per_m2: dot(&b.d2) / (h * h),
+        }
+    }
+}
+
+/// The stage-2 reference: α_r slews from 0 at `slew_rate_radps` until it meets the Eq. 35
+/// schedule, which it then follows (SPEC §6: "from 0 to 18° in 500 s along the slope of
+/// 6.2932e-4", clamped at the plateau, i.e. 499.2 s).
+///
+/// Written as α_r = min(ramp(τ), A(l)) for a positive plateau, so the hand-over is continuous
+/// and happens exactly when the ramp reaches the schedule.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlewedSchedule<T> {
+    /// The Eq. 35 schedule followed after the slew.
+    pub schedule: BandSchedule<T>,
+    /// Slew rate of α_r, rad/s (> 0).
+    pub slew_rate_radps: T,
+}
+
+/// α_r with its length derivatives and its explicit time derivative ∂α_r/∂t.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Reference<T> {
+    /// α_r and its length derivatives.
+    pub angle: RefAngle<T>,
+    /// ∂α_r/∂t at fixed l, rad/s (the `r` of SPEC §5; non-zero only during a slew).
+    pub time_rate_radps: T,
+    /// `true` while the slew is still below the schedule.
+    pub slewing: bool,
+}
+
+impl<T: Real> SlewedSchedule<T> {
+    /// The reference at stage time `tau_s` and tether length `length_m`.
+    pub fn eval(&self, tau_s: T, length_m: T) -> Reference<T> {
+        let scheduled = self.schedule.eval(length_m);
+        let ramp = self.slew_rate_radps * tau_s;
+        if ramp < scheduled.angle_rad {
+            Reference {
+                angle: RefAngle {
+                    angle_rad: ramp,
+                    slope_rad_per_m: T::ZERO,
+                    curvature_rad_per_m2: T::ZERO,
+                },
+                time_rate_radps: self.slew_rate_radps,
+                slewing: true,
+            }
+        } else {
+            Reference {
+                angle: scheduled,
+                time_rate_radps: T::ZERO,
+                slewing: false,
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use core::f64::consts::PI;
+
+    fn close(a: f64, b: f64, tol: f64) -> bool {
+        (a - b).abs() <= tol
+    }
+
+    /// The six boundary conditions of a quintic: value, slope and curvature at both ends.
+    fn check_six_conditions(s: &BandSchedule<f64>) {
+        let lo = s.eval(s.low_length_m + 1e-9);
+        let hi = s.eval(s.high_length_m - 1e-9);
+        let h = s.high_length_m - s.low_length_m;
+        assert!(close(lo.angle_rad, s.low_angle_rad, 1e-12));
+        assert!(close(lo.slope_rad_per_m, s.low_slope_rad_per_m, 1e-12));
+        assert!(close(lo.curvature_rad_per_m2, 0.0, 1e-12 / h));
+        assert!(close(hi.angle_rad, s.high_angle_rad, 1e-12));
+        assert!(close(hi.slope_rad_per_m, s.high_slope_rad_per_m, 1e-12));
+        assert!(close(hi.curvature_rad_per_m2, 0.0, 1e-12 / h));
+    }
+
+    #[test]
+    fn stage1_quintic_meets_its_six_conditions() {
+        check_six_conditions(&BandSchedule::paper_stage1());
+    }
+
+    #[test]
+    fn stage2_quintic_meets_its_six_conditions() {
+        check_six_conditions(&BandSchedule::paper_stage2());
+    }
+
+    #[test]
+    fn straight_pieces_match_eq34_and_eq35() {
+        let s1 = BandSchedule::<f64>::paper_stage1();
+        assert_eq!(s1.eval(1.0).angle_rad, -PI / 4.0);
+        assert_eq!(s1.eval(1.0).slope_rad_per_m, 0.0);
+        assert!(close(
+            s1.eval(31_000.0).angle_rad,
+            PI * 1e-5 * 1_000.0,
+            1e-15
+        ));
+        let s2 = BandSchedule::<f64>::paper_stage2();
+        assert_eq!(s2.eval(20_000.0).angle_rad, PI / 10.0);
+        assert!(close(
+            s2.eval(1_900.0).angle_rad,
+            -5.0 * PI * 1e-5 * 100.0,
+            1e-15
+        ));
+    }
+
+    #[test]
+    fn stage1_midpoint_by_hand() {
+        // s = 1/2: H0 = H5 = 1/2, H1 = 1/2 − 6/8 + 8/16 − 3/32 = 5/32, H4 = −4/8 + 7/16 − 3/32
+        // = −5/32. f = −π/8 + h k (−5/32) with h = 20 km, k = π·10⁻⁵.
+        let f = BandSchedule::<f64>::paper_stage1().eval(20_000.0).angle_rad;
+        let expect = -PI / 8.0 - 20_000.0 * PI * 1e-5 * 5.0 / 32.0;
+        assert!(close(f, expect, 1e-14), "{f} vs {expect}");
+    }
+
+    #[test]
+    fn derivatives_agree_with_finite_differences() {
+        for s in [
+            BandSchedule::<f64>::paper_stage1(),
+            BandSchedule::paper_stage2(),
+        ] {
+            let (a, b) = (s.low_length_m, s.high_length_m);
+            for i in 1..20 {
+                let l = a + (b - a) * f64::from(i) / 20.0;
+                let dl = 1e-2;
+                let (m, c, p) = (s.eval(l - dl), s.eval(l), s.eval(l + dl));
+                let d1 = (p.angle_rad - m.angle_rad) / (2.0 * dl);
+                let d2 = (p.slope_rad_per_m - m.slope_rad_per_m) / (2.0 * dl);
+                assert!(close(c.slope_rad_per_m, d1, 1e-10), "slope at {l}");
+                assert!(close(c.curvature_rad_per_m2, d2, 1e-12), "curvature at {l}");
+            }
+        }
+    }
+
+    #[test]
+    fn schedules_are_monotone_across_the_band() {
+        let s1 = BandSchedule::<f64>::paper_stage1();
+        let s2 = BandSchedule::<f64>::paper_stage2();
+        let mut prev1 = f64::NEG_INFINITY;
+        let mut prev2 = f64::NEG_INFINITY;
+        for i in 0..=1000 {
+            let l = 1_000.0 + 40.0 * f64::from(i);
+            let (a1, a2) = (s1.eval(l).angle_rad, s2.eval(l).angle_rad);
+            assert!(a1 >= prev1 && a2 >= prev2, "not monotone at {l}");
+            prev1 = a1;
+            prev2 = a2;
+        }
+    }
+
+    #[test]
+    fn slew_reaches_the_plateau_after_499_2_s() {
+        let sl = SlewedSchedule {
+            schedule: BandSchedule::<f64>::paper_stage2(),
+            slew_rate_radps: 6.2932e-4,
+        };
+        let r = sl.eval(100.0, 29_000.0);
+        assert!(r.slewing && close(r.angle.angle_rad, 0.062_932, 1e-12));
+        assert_eq!(r.time_rate_radps, 6.2932e-4);
+        let t_end = (PI / 10.0) / 6.2932e-4;
+        assert!(close(t_end, 499.2, 0.05), "{t_end}");
+        assert!(sl.eval(t_end - 0.01, 29_000.0).slewing);
+        let after = sl.eval(t_end + 0.01, 29_000.0);
+        assert!(!after.slewing && after.angle.angle_rad == PI / 10.0);
+        assert_eq!(after.time_rate_radps, 0.0);
+    }
+}
