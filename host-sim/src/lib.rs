@@ -1,2 +1,13 @@
 //! tss-sim: the desktop simulator of the tss-reel controller.
 #![warn(missing_docs)]
+
+pub mod analysis;
+pub mod history;
+pub mod output;
+pub mod plant;
+pub mod plots;
+pub mod report;
+pub mod run_cmd;
+pub mod scenario;
+pub mod sim;
+pub mod table1;

@@ -1,1 +1,56 @@
-fn main() {}
+//! `tss-sim`: the desktop simulator of the tss-reel controller.
+//!
+//! Exit codes: 0 success; 1 the run failed; 2 a usage error (bad arguments, scenario file,
+//! `--set` override or output path), reported before anything is written.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use tss_sim::{analysis, run_cmd};
+
+/// Exit code for usage errors (as clap uses for bad arguments).
+const EXIT_USAGE: u8 = 2;
+/// Exit code for a run that failed.
+const EXIT_FAILURE: u8 = 1;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "tss-sim",
+    version,
+    about = "Desktop simulator of the tss-reel controller (He, Liang & Xu 2011)"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Simulate a scenario; write history.csv, Figs. 4–6, the Table-1 comparison and a summary.
+    Run(run_cmd::RunArgs),
+    /// Whole-orbit extent of the equilibrium conditions (Figs. 2–3, Eqs. 9–13).
+    Extent(analysis::ExtentArgs),
+    /// Characteristic roots, D1, D2 and verdicts at one state (Eqs. 17–19), with an eigenvalue
+    /// cross-check.
+    Stability(analysis::StabilityArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run(args) => run_cmd::run(args),
+        Command::Extent(args) => analysis::run_extent(&args),
+        Command::Stability(args) => analysis::run_stability(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            if run_cmd::is_usage_error(&err) || analysis::is_usage_error(&err) {
+                ExitCode::from(EXIT_USAGE)
+            } else {
+                ExitCode::from(EXIT_FAILURE)
+            }
+        }
+    }
+}

@@ -352,6 +352,18 @@ impl Scenario {
         })?;
         let schema = schema();
         check_table(&table, "", schema, file, "")?;
+        if !overrides.is_empty() {
+            // Apply overrides on top of the file *with its defaults filled in*, so that setting
+            // one key of a section the file leaves to its default (e.g. `[envelope]`) keeps the
+            // section's other defaults. A file that is incomplete by itself is used as it is.
+            let complete = toml::Value::Table(table.clone())
+                .try_into::<Scenario>()
+                .ok()
+                .and_then(|sc| toml::Table::try_from(sc).ok());
+            if let Some(complete) = complete {
+                table = complete;
+            }
+        }
         let mut overridden = BTreeSet::new();
         for arg in overrides {
             let key = apply_override(&mut table, arg, schema, file)?;
@@ -382,7 +394,10 @@ impl Scenario {
         let name_ok = !s.name.trim().is_empty()
             && s.name != "."
             && s.name != ".."
-            && !s.name.chars().any(|c| c == '/' || c == '\\' || c.is_control());
+            && !s
+                .name
+                .chars()
+                .any(|c| c == '/' || c == '\\' || c.is_control());
         v.check(
             name_ok,
             "name",
@@ -602,9 +617,7 @@ impl Scenario {
                     ticks <= MAX_TICKS,
                     "simulation.duration_s",
                     num(sim.duration_s),
-                    &format!(
-                        "is {ticks} control periods, more than the simulator's {MAX_TICKS}"
-                    ),
+                    &format!("is {ticks} control periods, more than the simulator's {MAX_TICKS}"),
                 );
             }
         }
@@ -857,17 +870,11 @@ impl<'de> serde::Deserializer<'de> for Tracer<'_> {
         self.leaf(LeafKind::String);
         v.visit_str("")
     }
-    fn deserialize_string<V: serde::de::Visitor<'de>>(
-        self,
-        v: V,
-    ) -> Result<V::Value, TraceError> {
+    fn deserialize_string<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, TraceError> {
         self.leaf(LeafKind::String);
         v.visit_string(String::new())
     }
-    fn deserialize_option<V: serde::de::Visitor<'de>>(
-        self,
-        v: V,
-    ) -> Result<V::Value, TraceError> {
+    fn deserialize_option<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, TraceError> {
         v.visit_some(self)
     }
     fn deserialize_struct<V: serde::de::Visitor<'de>>(
@@ -1144,4 +1151,386 @@ fn lookup<'t>(table: &'t toml::Table, dotted: &str) -> Option<&'t toml::Value> {
         value = value.as_table()?.get(part)?;
     }
     Some(value)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A complete scenario (the paper's, with every section written out) for the rule tests.
+    const BASE: &str = r#"
+name = "base"
+description = "test scenario"
+[orbit]
+semi_major_axis_m = 7_078_000.0
+eccentricity = 0.0
+initial_true_anomaly_rad = 0.0
+[masses]
+main_initial_kg = 10_000.0
+sub_kg = 100.0
+[tether]
+density_kg_per_m = 0.0
+[initial]
+length_m = 1.0
+length_rate_mps = 0.1
+delta_rad = 0.17453292519943295
+delta_rate_radps = 0.0
+beta_rad = 0.0
+beta_rate_radps = 0.0
+[controller]
+period_s = 1.0
+k1_per_s = 0.0057
+k2_per_s2 = 9.8696e-6
+keep_capture_m = 1.0
+[stage1]
+decay_rate_per_s = 1.0e-3
+deploy_angle_rad = -0.7853981633974483
+band_start_m = 10_000.0
+keep_length_m = 30_000.0
+keep_slope_rad_per_m = 3.141592653589793e-5
+[stage2]
+start_time_s = 28_800.0
+decay_rate_per_s = 5.0e-4
+retrieve_angle_rad = 0.3141592653589793
+slew_rate_radps = 6.2932e-4
+band_start_m = 5_000.0
+keep_length_m = 2_000.0
+keep_slope_rad_per_m = 1.5707963267948966e-4
+[simulation]
+duration_s = 72_000.0
+substeps = 1
+output_interval_s = 10.0
+[envelope]
+max_rate_mps = 10.0
+max_accel_mps2 = 0.05
+min_length_m = 0.5
+max_length_m = 40_000.0
+"#;
+    const FILE: &str = "scenarios/x.toml";
+
+    fn load(sets: &[&str]) -> Result<Scenario, ScenarioError> {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        Scenario::from_toml_str(BASE, FILE, &sets)
+    }
+
+    fn err(sets: &[&str]) -> String {
+        match load(sets) {
+            Ok(_) => panic!("{sets:?} was accepted"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn the_base_and_every_shipped_scenario_load() {
+        let s = load(&[]).unwrap();
+        assert_eq!(s.name, "base");
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios");
+        let mut n = 0;
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|e| e == "toml") {
+                Scenario::load(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
+                n += 1;
+            }
+        }
+        assert!(n >= 1);
+    }
+
+    #[test]
+    fn schema_lists_every_key() {
+        let s = schema();
+        for key in [
+            "name",
+            "description",
+            "orbit.semi_major_axis_m",
+            "tether.density_kg_per_m",
+            "stage2.start_time_s",
+            "simulation.output_interval_s",
+            "envelope.max_length_m",
+        ] {
+            assert!(s.leaves.contains_key(key), "{key}");
+        }
+        assert_eq!(
+            s.leaves.get("simulation.substeps"),
+            Some(&LeafKind::Integer {
+                min: 0,
+                max: u32::MAX.into()
+            })
+        );
+        assert!(s.tables.contains("stage1"));
+        // Every leaf of a serialized scenario is in the schema and vice versa.
+        let value = toml::Value::try_from(load(&[]).unwrap()).unwrap();
+        let mut found = BTreeSet::new();
+        fn walk(v: &toml::Value, prefix: &str, out: &mut BTreeSet<String>) {
+            if let toml::Value::Table(t) = v {
+                for (k, v) in t {
+                    let full = join_key(prefix, k);
+                    if v.is_table() {
+                        walk(v, &full, out);
+                    } else {
+                        out.insert(full);
+                    }
+                }
+            }
+        }
+        walk(&value, "", &mut found);
+        let expected: BTreeSet<String> = s.leaves.keys().cloned().collect();
+        assert_eq!(found, expected);
+    }
+
+    #[test]
+    fn overrides_take_floats_integers_strings_and_apply_in_order() {
+        let s = load(&[
+            "tether.density_kg_per_m=1e-3",
+            "stage2.start_time_s=30000",
+            "simulation.duration_s=3600",
+            "name=foo",
+            "description=\"quoted text\"",
+            "simulation.substeps=4",
+            "controller.k1_per_s = 0.006",
+            "controller.k1_per_s=0.007",
+        ])
+        .unwrap();
+        assert_eq!(s.tether.density_kg_per_m, 1e-3);
+        assert_eq!(s.stage2.start_time_s, 30_000.0);
+        assert_eq!(s.simulation.duration_s, 3600.0);
+        assert_eq!(s.name, "foo");
+        assert_eq!(s.description, "quoted text");
+        assert_eq!(s.simulation.substeps, 4);
+        assert_eq!(s.controller.k1_per_s, 0.007);
+        // A string field takes any text, even one that looks like a number.
+        assert_eq!(load(&["name=42"]).unwrap().name, "42");
+    }
+
+    #[test]
+    fn an_integer_in_the_file_is_accepted_for_a_float_field() {
+        let text = BASE.replace("duration_s = 72_000.0", "duration_s = 7200");
+        let s = Scenario::from_toml_str(&text, FILE, &[]).unwrap();
+        assert_eq!(s.simulation.duration_s, 7200.0);
+    }
+
+    #[test]
+    fn an_override_can_set_a_key_the_file_leaves_to_its_default() {
+        let text = BASE.replace("eccentricity = 0.0\n", "");
+        let sets = ["orbit.eccentricity=0.01".to_string()];
+        let s = Scenario::from_toml_str(&text, FILE, &sets).unwrap();
+        assert_eq!(s.orbit.eccentricity, 0.01);
+    }
+
+    #[test]
+    fn an_override_into_a_defaulted_section_keeps_its_other_defaults() {
+        let start = BASE.find("[envelope]").unwrap();
+        let text = &BASE[..start];
+        let sets = ["envelope.max_rate_mps=100".to_string()];
+        let s = Scenario::from_toml_str(text, FILE, &sets).unwrap();
+        assert_eq!(s.envelope.max_rate_mps, 100.0);
+        assert_eq!(
+            s.envelope.max_accel_mps2,
+            EnvelopeSection::default().max_accel_mps2
+        );
+    }
+
+    #[test]
+    fn malformed_overrides_are_errors_naming_the_argument() {
+        let e = err(&["stage1.band_start_m"]);
+        assert!(
+            e.starts_with(FILE) && e.contains("stage1.band_start_m") && e.contains("key=value"),
+            "{e}"
+        );
+        let e = err(&["=3"]);
+        assert!(e.contains("dotted path"), "{e}");
+        let e = err(&["stage1..band_start_m=3"]);
+        assert!(e.contains("dotted path"), "{e}");
+    }
+
+    #[test]
+    fn unknown_override_keys_are_errors_naming_the_key() {
+        let e = err(&["stage1.band_start=3"]);
+        assert!(
+            e.starts_with(&format!(
+                "{FILE}: --set stage1.band_start=3: unknown key `stage1.band_start`"
+            )),
+            "{e}"
+        );
+        assert!(
+            e.contains("band_start_m"),
+            "the hint lists the valid keys: {e}"
+        );
+        let e = err(&["nosuch.key=1"]);
+        assert!(
+            e.contains("unknown key `nosuch.key`") && e.contains("top-level keys"),
+            "{e}"
+        );
+        let e = err(&["stage1=1"]);
+        assert!(
+            e.contains("unknown key `stage1`") && e.contains("is a section"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn override_values_of_the_wrong_type_are_errors_naming_key_and_value() {
+        let e = err(&["simulation.substeps=1.5"]);
+        assert!(e.contains(&format!("{FILE}: --set simulation.substeps=1.5: simulation.substeps = 1.5 must be an integer")), "{e}");
+        let e = err(&["simulation.substeps=-1"]);
+        assert!(
+            e.contains("simulation.substeps = -1 must be an integer in [0, 4294967295]"),
+            "{e}"
+        );
+        let e = err(&["simulation.duration_s=abc"]);
+        assert!(
+            e.contains("simulation.duration_s = \"abc\" must be a number"),
+            "{e}"
+        );
+        let e = err(&["simulation.duration_s=true"]);
+        assert!(
+            e.contains("simulation.duration_s = true must be a number"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn file_errors_name_the_file_and_key() {
+        let unknown = BASE.replace("[stage1]\n", "[stage1]\nbnad_start_m = 1.0\n");
+        let e = Scenario::from_toml_str(&unknown, FILE, &[])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(&format!("{FILE}: unknown key `stage1.bnad_start_m`")),
+            "{e}"
+        );
+        let wrong = BASE.replace("substeps = 1", "substeps = \"one\"");
+        let e = Scenario::from_toml_str(&wrong, FILE, &[])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!(
+                "{FILE}: simulation.substeps = \"one\" must be an integer"
+            )),
+            "{e}"
+        );
+        let missing = BASE.replace("k1_per_s = 0.0057\n", "");
+        let e = Scenario::from_toml_str(&missing, FILE, &[])
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, format!("{FILE}: missing key `controller.k1_per_s`"));
+        let no_section = BASE.replace("[masses]\nmain_initial_kg = 10_000.0\nsub_kg = 100.0\n", "");
+        let e = Scenario::from_toml_str(&no_section, FILE, &[])
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, format!("{FILE}: missing key `masses`"));
+        let e = Scenario::from_toml_str("name = ", FILE, &[])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(&format!("{FILE}: not valid TOML")) && e.contains("line 1"),
+            "{e}"
+        );
+        let e = Scenario::load("/nonexistent/dir/x.toml", &[]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "/nonexistent/dir/x.toml: cannot read the scenario file"
+        );
+    }
+
+    /// Every validation rule: the override that breaks it, the field and value named, and a
+    /// piece of the message.
+    #[test]
+    fn every_rule_names_file_field_and_value() {
+        let cases: &[(&[&str], &str, &str, &str)] = &[
+            (&["name=a/b"], "name", "\"a/b\"", "file name"),
+            (&["name=.."], "name", "\"..\"", "file name"),
+            (&["orbit.semi_major_axis_m=-1"], "orbit.semi_major_axis_m", "-1", "must be above 0"),
+            (&["orbit.semi_major_axis_m=6000000"], "orbit.semi_major_axis_m", "6000000", "inside the Earth"),
+            (&["orbit.eccentricity=0.2"], "orbit.semi_major_axis_m", "7078000", "inside the Earth"),
+            (&["orbit.eccentricity=1"], "orbit.eccentricity", "1", "must be in [0, 1)"),
+            (&["orbit.eccentricity=-0.1"], "orbit.eccentricity", "-0.1", "must be in [0, 1)"),
+            (&["orbit.initial_true_anomaly_rad=nan"], "orbit.initial_true_anomaly_rad", "NaN", "finite"),
+            (&["masses.main_initial_kg=0"], "masses.main_initial_kg", "0", "must be above 0"),
+            (&["masses.sub_kg=-5"], "masses.sub_kg", "-5", "must be above 0"),
+            (&["masses.sub_kg=inf"], "masses.sub_kg", "inf", "finite"),
+            (&["initial.length_m=0"], "initial.length_m", "0", "must be above 0"),
+            (&["initial.length_m=0.25"], "initial.length_m", "0.25", "within [envelope.min_length_m, envelope.max_length_m] = [0.5, 40000]"),
+            (&["initial.length_rate_mps=inf"], "initial.length_rate_mps", "inf", "finite"),
+            (&["initial.length_rate_mps=-11"], "initial.length_rate_mps", "-11", "±envelope.max_rate_mps = 10"),
+            (&["initial.delta_rad=nan"], "initial.delta_rad", "NaN", "finite"),
+            (&["initial.delta_rate_radps=-inf"], "initial.delta_rate_radps", "-inf", "finite"),
+            (&["initial.beta_rad=2"], "initial.beta_rad", "2", "(−π/2, π/2)"),
+            (&["initial.beta_rate_radps=nan"], "initial.beta_rate_radps", "NaN", "finite"),
+            (&["controller.period_s=0"], "controller.period_s", "0", "must be above 0"),
+            (&["controller.k1_per_s=0"], "controller.k1_per_s", "0", "must be above 0"),
+            (&["controller.k2_per_s2=-1e-6"], "controller.k2_per_s2", "-0.000001", "must be above 0"),
+            (&["controller.keep_capture_m=0"], "controller.keep_capture_m", "0", "must be above 0"),
+            (&["envelope.max_rate_mps=0"], "envelope.max_rate_mps", "0", "must be above 0"),
+            (&["envelope.max_accel_mps2=-1"], "envelope.max_accel_mps2", "-1", "must be above 0"),
+            (&["envelope.min_length_m=0"], "envelope.min_length_m", "0", "must be above 0"),
+            (&["envelope.max_length_m=0.4"], "envelope.max_length_m", "0.4", "must be above envelope.min_length_m = 0.5"),
+            (&["stage1.decay_rate_per_s=-1e-3"], "stage1.decay_rate_per_s", "-0.001", "must not be negative"),
+            (&["stage1.deploy_angle_rad=0.1"], "stage1.deploy_angle_rad", "0.1", "(−π/2, 0)"),
+            (&["stage1.deploy_angle_rad=-1.6"], "stage1.deploy_angle_rad", "-1.6", "(−π/2, 0)"),
+            (&["stage1.band_start_m=40000"], "stage1.band_start_m", "40000", "must be below stage1.keep_length_m = 30000"),
+            (&["stage1.band_start_m=0"], "stage1.band_start_m", "0", "must be above 0"),
+            (&["stage1.keep_length_m=45000"], "stage1.keep_length_m", "45000", "inside the envelope"),
+            (&["stage1.keep_slope_rad_per_m=-1e-5"], "stage1.keep_slope_rad_per_m", "-0.00001", "must not be negative"),
+            (&["stage2.start_time_s=-1"], "stage2.start_time_s", "-1", "must not be negative"),
+            (&["stage2.start_time_s=0.5"], "stage2.start_time_s", "0.5", "whole multiple of controller.period_s = 1"),
+            (&["stage2.decay_rate_per_s=-1"], "stage2.decay_rate_per_s", "-1", "must not be negative"),
+            (&["stage2.retrieve_angle_rad=-0.3"], "stage2.retrieve_angle_rad", "-0.3", "(0, π/2)"),
+            (&["stage2.slew_rate_radps=0"], "stage2.slew_rate_radps", "0", "must be above 0"),
+            (&["stage2.band_start_m=1000"], "stage2.band_start_m", "1000", "must be above stage2.keep_length_m = 2000"),
+            (&["stage2.keep_length_m=31000", "stage2.band_start_m=32000"], "stage2.keep_length_m", "31000", "must be below stage1.keep_length_m = 30000"),
+            (&["stage2.keep_length_m=0.5"], "stage2.keep_length_m", "0.5", "inside the envelope"),
+            (&["stage2.keep_slope_rad_per_m=-1"], "stage2.keep_slope_rad_per_m", "-1", "must not be negative"),
+            (&["tether.density_kg_per_m=-1e-3"], "tether.density_kg_per_m", "-0.001", "must not be negative"),
+            (&["tether.density_kg_per_m=0.25"], "tether.density_kg_per_m", "0.25", "envelope.max_length_m = 40000 m weigh 10000 kg, not below masses.main_initial_kg = 10000"),
+            (&["simulation.duration_s=0"], "simulation.duration_s", "0", "must be above 0"),
+            (&["simulation.duration_s=600.5"], "simulation.duration_s", "600.5", "whole multiple of controller.period_s"),
+            (&["simulation.duration_s=1e10"], "simulation.duration_s", "10000000000", "more than the simulator's"),
+            (&["simulation.substeps=0"], "simulation.substeps", "0", "must be at least 1"),
+            (&["simulation.output_interval_s=0"], "simulation.output_interval_s", "0", "must be above 0"),
+            (&["simulation.output_interval_s=2.5"], "simulation.output_interval_s", "2.5", "positive whole multiple of controller.period_s = 1"),
+        ];
+        for (sets, field, value, message) in cases {
+            let e = err(sets);
+            let head = format!("{FILE}: {field} = {value} ");
+            let line = e
+                .lines()
+                .find(|l| l.starts_with(&head))
+                .unwrap_or_else(|| panic!("{sets:?}: no line starting {head:?} in:\n{e}"));
+            assert!(
+                line.contains(message),
+                "{sets:?}: {line:?} lacks {message:?}"
+            );
+            if sets.iter().any(|s| s.starts_with(&format!("{field}="))) {
+                assert!(line.ends_with("(set by --set)"), "{line}");
+            }
+        }
+    }
+
+    #[test]
+    fn all_problems_are_reported_at_once() {
+        let e = load(&["masses.sub_kg=0", "controller.k1_per_s=0"]).unwrap_err();
+        match e {
+            ScenarioError::Invalid { problems, .. } => {
+                let fields: Vec<&str> = problems.iter().map(|p| p.field.as_str()).collect();
+                assert_eq!(fields, ["masses.sub_kg", "controller.k1_per_s"]);
+            }
+            other => panic!("{other}"),
+        }
+    }
+
+    #[test]
+    fn the_paper_scenario_is_valid_and_its_rules_hold_in_the_example_from_the_brief() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/paper.toml");
+        let e = Scenario::load(path, &["stage1.band_start_m=40000".to_string()])
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            format!(
+                "{path}: stage1.band_start_m = 40000 must be below stage1.keep_length_m = 30000 \
+                 (set by --set)"
+            )
+        );
+    }
 }

@@ -1,0 +1,323 @@
+//! The paper's Figs. 4–6 drawn from a run, as PNG and SVG.
+//!
+//! - Fig. 4: tether length l (km) and tension T_t (N) against t (h), two panels.
+//! - Fig. 5: (a) the reference angle α_r and (b) the in-plane angle α (deg) against t (h).
+//! - Fig. 6: the same angles against l (km).
+//!
+//! Text is rendered with plotters' `ttf` feature, which finds a sans-serif system font through
+//! fontconfig (DejaVu Sans on the project's Debian machines, package `fonts-dejavu-core`).
+//! Long histories are thinned with a min/max envelope per bucket, so peaks survive.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{anyhow, Context};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::history::{History, Sample};
+use crate::scenario::Scenario;
+
+/// Seconds per hour.
+const S_PER_H: f64 = 3600.0;
+/// Metres per kilometre.
+const M_PER_KM: f64 = 1000.0;
+/// Pixel size of the two-panel figures.
+pub const FIGURE_SIZE_PX: (u32, u32) = (1200, 900);
+/// Points drawn per series at most (the rest is thinned, keeping each bucket's min and max).
+pub const MAX_POINTS_PER_SERIES: usize = 4000;
+/// Font family for all text.
+const FONT: &str = "sans-serif";
+
+/// File stems of the figures, in order (each written as `.png` and `.svg`).
+pub const FIGURE_STEMS: [&str; 3] = [
+    "fig4_length_tension",
+    "fig5_angles_time",
+    "fig6_angles_length",
+];
+
+const LENGTH_COLOR: RGBColor = RGBColor(0x1f, 0x77, 0xb4);
+const TENSION_COLOR: RGBColor = RGBColor(0xd6, 0x27, 0x28);
+const ALPHA_COLOR: RGBColor = RGBColor(0x1f, 0x77, 0xb4);
+const ALPHA_REF_COLOR: RGBColor = RGBColor(0xff, 0x7f, 0x0e);
+const STAGE_LINE_COLOR: RGBColor = RGBColor(0x99, 0x99, 0x99);
+
+/// One curve of a panel.
+struct Curve {
+    label: &'static str,
+    color: RGBColor,
+    dashed: bool,
+    points: Vec<(f64, f64)>,
+}
+
+/// One panel: a caption, axis descriptions and its curves.
+struct Panel {
+    caption: String,
+    x_desc: &'static str,
+    y_desc: &'static str,
+    curves: Vec<Curve>,
+    /// x of a vertical marker (the stage-2 start), if inside the data.
+    marker_x: Option<f64>,
+}
+
+/// Writes the three figures to `dir` as PNG and SVG; returns the paths written.
+pub fn write_figures(
+    dir: &Path,
+    scenario: &Scenario,
+    history: &History,
+) -> anyhow::Result<Vec<PathBuf>> {
+    let figures = figures(scenario, &history.samples);
+    let mut written = Vec::new();
+    for (stem, panels) in FIGURE_STEMS.iter().zip(&figures) {
+        let png = dir.join(format!("{stem}.png"));
+        {
+            let root = BitMapBackend::new(&png, FIGURE_SIZE_PX).into_drawing_area();
+            draw(&root, panels).with_context(|| format!("drawing {}", png.display()))?;
+            root.present()
+                .map_err(|e| anyhow!("{e}"))
+                .with_context(|| format!("writing {}", png.display()))?;
+        }
+        written.push(png);
+        let svg = dir.join(format!("{stem}.svg"));
+        {
+            let root = SVGBackend::new(&svg, FIGURE_SIZE_PX).into_drawing_area();
+            draw(&root, panels).with_context(|| format!("drawing {}", svg.display()))?;
+            root.present()
+                .map_err(|e| anyhow!("{e}"))
+                .with_context(|| format!("writing {}", svg.display()))?;
+        }
+        written.push(svg);
+    }
+    Ok(written)
+}
+
+/// The panels of Figs. 4, 5 and 6.
+fn figures(scenario: &Scenario, samples: &[Sample]) -> [Vec<Panel>; 3] {
+    let name = &scenario.name;
+    let t_h = |s: &Sample| s.t_s / S_PER_H;
+    let l_km = |s: &Sample| s.length_m / M_PER_KM;
+    let series = |x: &dyn Fn(&Sample) -> f64, y: &dyn Fn(&Sample) -> f64| -> Vec<(f64, f64)> {
+        thin(samples.iter().map(|s| (x(s), y(s))).collect())
+    };
+    let end_h = samples.last().map_or(0.0, t_h);
+    let stage2_h = scenario.stage2.start_time_s / S_PER_H;
+    let marker = (stage2_h > 0.0 && stage2_h < end_h).then_some(stage2_h);
+    let alpha_ref = |x: &dyn Fn(&Sample) -> f64, dashed: bool| Curve {
+        label: "α_r (reference)",
+        color: ALPHA_REF_COLOR,
+        dashed,
+        points: series(x, &|s| s.alpha_ref_rad.to_degrees()),
+    };
+    let alpha = |x: &dyn Fn(&Sample) -> f64| Curve {
+        label: "α (actual)",
+        color: ALPHA_COLOR,
+        dashed: false,
+        points: series(x, &|s| s.alpha_rad.to_degrees()),
+    };
+    let fig4 = vec![
+        Panel {
+            caption: format!("Fig. 4 (a): tether length — scenario {name}"),
+            x_desc: "t (h)",
+            y_desc: "l (km)",
+            curves: vec![Curve {
+                label: "l",
+                color: LENGTH_COLOR,
+                dashed: false,
+                points: series(&t_h, &l_km),
+            }],
+            marker_x: marker,
+        },
+        Panel {
+            caption: "Fig. 4 (b): tether tension".to_string(),
+            x_desc: "t (h)",
+            y_desc: "T_t (N)",
+            curves: vec![Curve {
+                label: "T_t",
+                color: TENSION_COLOR,
+                dashed: false,
+                points: series(&t_h, &|s| s.tension_n),
+            }],
+            marker_x: marker,
+        },
+    ];
+    let fig5 = vec![
+        Panel {
+            caption: format!("Fig. 5 (a): reference in-plane angle — scenario {name}"),
+            x_desc: "t (h)",
+            y_desc: "α_r (deg)",
+            curves: vec![alpha_ref(&t_h, false)],
+            marker_x: marker,
+        },
+        Panel {
+            caption: "Fig. 5 (b): actual in-plane angle".to_string(),
+            x_desc: "t (h)",
+            y_desc: "α (deg)",
+            curves: vec![alpha(&t_h), alpha_ref(&t_h, true)],
+            marker_x: marker,
+        },
+    ];
+    let fig6 = vec![
+        Panel {
+            caption: format!(
+                "Fig. 6 (a): reference in-plane angle against length — scenario {name}"
+            ),
+            x_desc: "l (km)",
+            y_desc: "α_r (deg)",
+            curves: vec![alpha_ref(&l_km, false)],
+            marker_x: None,
+        },
+        Panel {
+            caption: "Fig. 6 (b): actual in-plane angle against length".to_string(),
+            x_desc: "l (km)",
+            y_desc: "α (deg)",
+            curves: vec![alpha(&l_km), alpha_ref(&l_km, true)],
+            marker_x: None,
+        },
+    ];
+    [fig4, fig5, fig6]
+}
+
+/// Thins a long series to at most [`MAX_POINTS_PER_SERIES`] points, keeping the min and max `y`
+/// of each bucket (in their original order) and the last point.
+fn thin(points: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    let n = points.len();
+    if n <= MAX_POINTS_PER_SERIES {
+        return points;
+    }
+    let buckets = MAX_POINTS_PER_SERIES / 2 - 1;
+    let per = n.div_ceil(buckets);
+    let mut out = Vec::with_capacity(MAX_POINTS_PER_SERIES);
+    for chunk in points.chunks(per) {
+        let (mut lo, mut hi) = (0, 0);
+        for (i, p) in chunk.iter().enumerate() {
+            if p.1 < chunk[lo].1 {
+                lo = i;
+            }
+            if p.1 > chunk[hi].1 {
+                hi = i;
+            }
+        }
+        let (a, b) = if lo <= hi { (lo, hi) } else { (hi, lo) };
+        out.push(chunk[a]);
+        if b != a {
+            out.push(chunk[b]);
+        }
+    }
+    if let (Some(&last), Some(&kept)) = (points.last(), out.last()) {
+        if kept != last {
+            out.push(last);
+        }
+    }
+    out
+}
+
+/// The finite range of `values`, padded by 5 % (±1 when flat, 0..1 when empty).
+fn padded_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if lo > hi {
+        return (0.0, 1.0);
+    }
+    if hi - lo <= f64::EPSILON * hi.abs().max(1.0) {
+        return (lo - 1.0, hi + 1.0);
+    }
+    let pad = 0.05 * (hi - lo);
+    (lo - pad, hi + pad)
+}
+
+/// Draws the panels stacked vertically on `root`.
+fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, panels: &[Panel]) -> anyhow::Result<()> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("{e}");
+    root.fill(&WHITE).map_err(err)?;
+    let areas = root.split_evenly((panels.len(), 1));
+    for (area, panel) in areas.iter().zip(panels) {
+        draw_panel(area, panel).map_err(err)?;
+    }
+    Ok(())
+}
+
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    panel: &Panel,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let all = || panel.curves.iter().flat_map(|c| c.points.iter());
+    let (x0, x1) = padded_range(all().map(|p| p.0));
+    let (y0, y1) = padded_range(all().map(|p| p.1));
+    let mut chart = ChartBuilder::on(area)
+        .caption(&panel.caption, (FONT, 22))
+        .margin(14)
+        .x_label_area_size(48)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x0..x1, y0..y1)?;
+    chart
+        .configure_mesh()
+        .x_desc(panel.x_desc)
+        .y_desc(panel.y_desc)
+        .label_style((FONT, 16))
+        .axis_desc_style((FONT, 18))
+        .light_line_style(RGBColor(0xee, 0xee, 0xee))
+        .draw()?;
+    if let Some(x) = panel.marker_x {
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(x, y0), (x, y1)],
+                4,
+                6,
+                STAGE_LINE_COLOR.stroke_width(1),
+            ))?
+            .label("stage 2 starts")
+            .legend(|(x, y)| PathElement::new([(x, y), (x + 24, y)], STAGE_LINE_COLOR));
+    }
+    for curve in &panel.curves {
+        let color = curve.color;
+        let finite = curve
+            .points
+            .iter()
+            .copied()
+            .filter(|p| p.0.is_finite() && p.1.is_finite());
+        let drawn = if curve.dashed {
+            chart.draw_series(DashedLineSeries::new(finite, 8, 6, color.stroke_width(2)))?
+        } else {
+            chart.draw_series(LineSeries::new(finite, color.stroke_width(2)))?
+        };
+        drawn
+            .label(curve.label)
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 24, y)], color.stroke_width(2)));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font((FONT, 16))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thinning_keeps_extremes_and_bounds_the_count() {
+        let mut pts: Vec<(f64, f64)> = (0..100_000).map(|i| (i as f64, 0.0)).collect();
+        pts[54_321].1 = 7.0;
+        pts[12_345].1 = -3.0;
+        let thin = thin(pts.clone());
+        assert!(thin.len() <= MAX_POINTS_PER_SERIES);
+        assert!(thin.contains(&(54_321.0, 7.0)));
+        assert!(thin.contains(&(12_345.0, -3.0)));
+        assert_eq!(thin.last(), pts.last());
+        assert!(thin.windows(2).all(|w| w[0].0 < w[1].0));
+    }
+
+    #[test]
+    fn ranges_are_padded_and_never_empty() {
+        assert_eq!(padded_range([].into_iter()), (0.0, 1.0));
+        assert_eq!(padded_range([2.0, 2.0].into_iter()), (1.0, 3.0));
+        let (lo, hi) = padded_range([0.0, 10.0, f64::NAN].into_iter());
+        assert!((lo + 0.5).abs() < 1e-12 && (hi - 10.5).abs() < 1e-12);
+    }
+}

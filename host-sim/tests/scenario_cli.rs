@@ -1,0 +1,159 @@
+//! `tss-sim run` rejects a bad scenario file, key, value or output path with exit code 2, a
+//! message naming the file, field and value, and without creating or writing anything.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_tss-sim");
+
+fn paper() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper.toml")
+}
+
+fn run(args: &[&str], cwd: &Path) -> Output {
+    Command::new(BIN)
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("tss-sim runs")
+}
+
+/// Runs `tss-sim run <scenario> --out <tmp>/out <extra...>` and checks exit 2, nothing
+/// written, and stderr containing every one of `expect`.
+fn rejected(scenario: &Path, extra: &[&str], expect: &[&str]) {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let mut args = vec![
+        "run",
+        scenario.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let o = run(&args, tmp.path());
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: stderr {stderr}");
+    assert!(!out.exists(), "{args:?} created {}", out.display());
+    // Nothing at all was written, not even a default output directory.
+    let left: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().collect();
+    assert!(left.is_empty(), "{args:?} wrote {left:?}");
+    for e in expect {
+        assert!(stderr.contains(e), "{args:?}: stderr lacks {e:?}: {stderr}");
+    }
+    assert!(o.stdout.is_empty(), "{args:?} printed on stdout");
+}
+
+#[test]
+fn a_missing_file_exits_2() {
+    rejected(
+        Path::new("/nonexistent/scenario.toml"),
+        &[],
+        &["/nonexistent/scenario.toml", "cannot read"],
+    );
+}
+
+#[test]
+fn a_file_that_is_not_toml_exits_2() {
+    let tmp = tempfile::tempdir().unwrap();
+    let bad = tmp.path().join("bad.toml");
+    std::fs::write(&bad, "name = \n").unwrap();
+    rejected(&bad, &[], &["bad.toml", "not valid TOML", "line 1"]);
+}
+
+#[test]
+fn an_unknown_key_in_the_file_exits_2() {
+    let tmp = tempfile::tempdir().unwrap();
+    let bad = tmp.path().join("typo.toml");
+    let text = std::fs::read_to_string(paper()).unwrap();
+    std::fs::write(
+        &bad,
+        text.replace("band_start_m = 10_000.0", "band_strat_m = 10_000.0"),
+    )
+    .unwrap();
+    rejected(
+        &bad,
+        &[],
+        &["typo.toml", "unknown key `stage1.band_strat_m`"],
+    );
+}
+
+#[test]
+fn an_unknown_override_key_exits_2() {
+    rejected(
+        &paper(),
+        &["--set", "stage1.band_start=5"],
+        &["paper.toml", "unknown key `stage1.band_start`"],
+    );
+}
+
+#[test]
+fn a_malformed_override_exits_2() {
+    rejected(&paper(), &["--set", "stage1.band_start_m"], &["key=value"]);
+}
+
+#[test]
+fn an_override_of_the_wrong_type_exits_2() {
+    rejected(
+        &paper(),
+        &["--set", "simulation.substeps=two"],
+        &["simulation.substeps = \"two\" must be an integer"],
+    );
+}
+
+#[test]
+fn a_physically_invalid_value_exits_2() {
+    rejected(
+        &paper(),
+        &["--set", "stage1.band_start_m=40000"],
+        &["paper.toml: stage1.band_start_m = 40000 must be below stage1.keep_length_m = 30000"],
+    );
+    rejected(
+        &paper(),
+        &["--set", "masses.sub_kg=0", "-s", "orbit.eccentricity=1.5"],
+        &[
+            "masses.sub_kg = 0 must be above 0",
+            "orbit.eccentricity = 1.5 must be in [0, 1)",
+        ],
+    );
+}
+
+#[test]
+fn an_output_path_that_is_a_file_exits_2_and_is_left_alone() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("taken");
+    std::fs::write(&file, "keep me").unwrap();
+    let scenario = paper();
+    let args = [
+        "run",
+        scenario.to_str().unwrap(),
+        "--out",
+        file.to_str().unwrap(),
+    ];
+    let o = run(&args, tmp.path());
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("not a directory"), "{stderr}");
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "keep me");
+    // Below a file: cannot be created either.
+    let below = file.join("sub");
+    let o = run(
+        &[
+            "run",
+            paper().to_str().unwrap(),
+            "--out",
+            below.to_str().unwrap(),
+        ],
+        tmp.path(),
+    );
+    assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn bad_command_line_arguments_exit_2() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = run(&["run"], tmp.path());
+    assert_eq!(o.status.code(), Some(2));
+    let o = run(&["run", paper().to_str().unwrap(), "--bogus"], tmp.path());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(std::fs::read_dir(tmp.path()).unwrap().next().is_none());
+}
