@@ -8,8 +8,10 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod equilibrium;
 pub mod mass;
 pub mod orbit;
 pub mod real;
+pub mod stability;
 
 pub use real::Real;
