@@ -23,279 +23,16 @@
 //! Time is an integer tick count (one tick = one control period); the controller never
 //! accumulates time in floating point.
 
-use crate::law::{self, Gains, LawFault, LawInput};
-use crate::mass::MassModel;
+use crate::envelope::Saturation;
+use crate::equilibrium::{Anomaly, ExistenceMonitor};
+use crate::law::{self, LawFault, LawInput};
+use crate::monitor::Monitor;
 use crate::real::Real;
-use crate::schedule::{BandSchedule, Reference, SlewedSchedule};
+use crate::schedule::{Reference, SlewedSchedule};
 
-/// Stage 1 (Eq. 34): deploy, then keep.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Stage1Config<T> {
-    /// The Eq. 34 reference schedule; its `high_length_m` is the keep length.
-    pub schedule: BandSchedule<T>,
-    /// c of Eq. 29 in stage 1, 1/s.
-    pub decay_rate_per_s: T,
-}
-
-/// Stage 2 (slew, then Eq. 35): retrieve, then keep.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Stage2Config<T> {
-    /// The Eq. 35 reference schedule; its `low_length_m` is the keep length.
-    pub schedule: BandSchedule<T>,
-    /// Slew rate of α_r from 0 to the plateau at the stage start, rad/s.
-    pub slew_rate_radps: T,
-    /// c of Eq. 29 in stage 2, 1/s.
-    pub decay_rate_per_s: T,
-    /// Tick at which stage 2 starts by itself; `None` waits for [`Controller::start_stage2`].
-    pub start_tick: Option<u32>,
-}
-
-/// The operating envelope: the command never leaves it, whatever the law asks.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Envelope<T> {
-    /// Largest reel speed in either direction, m/s.
-    pub max_rate_mps: T,
-    /// Largest change of reel speed per second, m/s².
-    pub max_accel_mps2: T,
-    /// Shortest tether (docking), m.
-    pub min_length_m: T,
-    /// Longest tether (spool capacity), m.
-    pub max_length_m: T,
-}
-
-/// Everything that defines a controller. Validated once by [`Controller::new`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Config<T> {
-    /// Control period, s (one tick).
-    pub period_s: T,
-    /// Masses (for μ3 of Eq. 27).
-    pub masses: MassModel<T>,
-    /// k1, k2 of Eq. 27.
-    pub gains: Gains<T>,
-    /// l̇0 of stage 1: the reel's rate at release, m/s (Eq. 29).
-    pub initial_rate_mps: T,
-    /// Stage 1.
-    pub stage1: Stage1Config<T>,
-    /// Stage 2.
-    pub stage2: Stage2Config<T>,
-    /// A keep phase is entered when l comes within this distance of its keep length, m.
-    pub keep_capture_m: T,
-    /// Rate, acceleration and length limits.
-    pub envelope: Envelope<T>,
-}
-
-impl<T: Real> Config<T> {
-    /// The paper's Section 6 (SPEC §7): 1 s period, ρ = 0, l̇0 = 0.1 m/s, k1 = 0.0057 s⁻¹,
-    /// k2 = 9.8696e-6 s⁻², c = 1e-3 s⁻¹ then 5e-4 s⁻¹, slew 6.2932e-4 rad/s, stage 2 at
-    /// t = 8 h.
-    ///
-    /// The envelope (15 m/s, 15 m/s², 0.5 m to 40 km) is wide enough never to act in the
-    /// paper's mission, which had no reel limits: its law peaks at 13.1 m/s and steps the rate
-    /// by 11.8 m/s in one second when the stage-2 slew hands over to Eq. 35 (α̇_r drops from
-    /// the slew rate to 0). A real reel needs a tighter envelope; see
-    /// `scenarios/paper-reel-limits.toml`.
-    pub fn paper() -> Self {
-        Self {
-            period_s: T::ONE,
-            masses: MassModel::paper(),
-            gains: Gains::paper(),
-            initial_rate_mps: T::from_f64(0.1),
-            stage1: Stage1Config {
-                schedule: BandSchedule::paper_stage1(),
-                decay_rate_per_s: T::from_f64(1e-3),
-            },
-            stage2: Stage2Config {
-                schedule: BandSchedule::paper_stage2(),
-                slew_rate_radps: T::from_f64(6.2932e-4),
-                decay_rate_per_s: T::from_f64(5e-4),
-                start_tick: Some(8 * 3600),
-            },
-            keep_capture_m: T::ONE,
-            envelope: Envelope {
-                max_rate_mps: T::from_f64(15.0),
-                max_accel_mps2: T::from_f64(15.0),
-                min_length_m: T::from_f64(0.5),
-                max_length_m: T::from_f64(40_000.0),
-            },
-        }
-    }
-
-    /// Checks every parameter; the first violation is returned.
-    pub fn validate(&self) -> Result<(), ConfigError> {
-        let z = T::ZERO;
-        positive("period_s", self.period_s)?;
-        positive("masses.main_initial_kg", self.masses.main_initial_kg)?;
-        positive("masses.sub_kg", self.masses.sub_kg)?;
-        at_least(
-            "masses.tether_density_kg_per_m",
-            self.masses.tether_density_kg_per_m,
-            z,
-        )?;
-        positive("gains.k1_per_s", self.gains.k1_per_s)?;
-        positive("gains.k2_per_s2", self.gains.k2_per_s2)?;
-        at_least("stage1.decay_rate_per_s", self.stage1.decay_rate_per_s, z)?;
-        at_least("stage2.decay_rate_per_s", self.stage2.decay_rate_per_s, z)?;
-        positive("stage2.slew_rate_radps", self.stage2.slew_rate_radps)?;
-        positive("keep_capture_m", self.keep_capture_m)?;
-        let env = &self.envelope;
-        positive("envelope.max_rate_mps", env.max_rate_mps)?;
-        positive("envelope.max_accel_mps2", env.max_accel_mps2)?;
-        positive("envelope.min_length_m", env.min_length_m)?;
-        above("envelope.max_length_m", env.max_length_m, env.min_length_m)?;
-        finite("initial_rate_mps", self.initial_rate_mps)?;
-        if self.initial_rate_mps.abs() > env.max_rate_mps {
-            return Err(ConfigError::new(
-                "initial_rate_mps",
-                self.initial_rate_mps,
-                Rule::OutsideEnvelope,
-            ));
-        }
-        // The whole tether must weigh less than the main satellite that carries it.
-        let tether_kg = self.masses.tether_density_kg_per_m * env.max_length_m;
-        if !(tether_kg < self.masses.main_initial_kg) {
-            return Err(ConfigError::new(
-                "masses.tether_density_kg_per_m",
-                self.masses.tether_density_kg_per_m,
-                Rule::TetherHeavierThanSatellite,
-            ));
-        }
-        for (name, s) in [
-            ("stage1.schedule", &self.stage1.schedule),
-            ("stage2.schedule", &self.stage2.schedule),
-        ] {
-            for v in [
-                s.low_length_m,
-                s.low_angle_rad,
-                s.low_slope_rad_per_m,
-                s.high_length_m,
-                s.high_angle_rad,
-                s.high_slope_rad_per_m,
-            ] {
-                finite(name, v)?;
-            }
-            if !(s.low_length_m < s.high_length_m) {
-                return Err(ConfigError::new(name, s.low_length_m, Rule::BandInverted));
-            }
-        }
-        // Deployment needs α_r on the deployment side, (−π/2, 0) (Eq. 33, SPEC §9.5);
-        // retrieval on the retrieval side, (0, π/2).
-        let half_pi = T::from_f64(core::f64::consts::FRAC_PI_2);
-        let deploy = self.stage1.schedule.low_angle_rad;
-        if !(deploy < z && deploy > -half_pi) {
-            return Err(ConfigError::new(
-                "stage1.schedule.low_angle_rad",
-                deploy,
-                Rule::WrongQuadrant,
-            ));
-        }
-        let retrieve = self.stage2.schedule.high_angle_rad;
-        if !(retrieve > z && retrieve < half_pi) {
-            return Err(ConfigError::new(
-                "stage2.schedule.high_angle_rad",
-                retrieve,
-                Rule::WrongQuadrant,
-            ));
-        }
-        let keep1 = self.stage1.schedule.high_length_m;
-        let keep2 = self.stage2.schedule.low_length_m;
-        for (name, v) in [
-            ("stage1.schedule.high_length_m", keep1),
-            ("stage2.schedule.low_length_m", keep2),
-        ] {
-            if !(v > env.min_length_m && v < env.max_length_m) {
-                return Err(ConfigError::new(name, v, Rule::OutsideEnvelope));
-            }
-        }
-        Ok(())
-    }
-}
-
-fn finite<T: Real>(param: &'static str, v: T) -> Result<(), ConfigError> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(ConfigError::new(param, v, Rule::NotFinite))
-    }
-}
-
-fn positive<T: Real>(param: &'static str, v: T) -> Result<(), ConfigError> {
-    finite(param, v)?;
-    if v > T::ZERO {
-        Ok(())
-    } else {
-        Err(ConfigError::new(param, v, Rule::NotPositive))
-    }
-}
-
-fn at_least<T: Real>(param: &'static str, v: T, min: T) -> Result<(), ConfigError> {
-    finite(param, v)?;
-    if v >= min {
-        Ok(())
-    } else {
-        Err(ConfigError::new(param, v, Rule::Negative))
-    }
-}
-
-fn above<T: Real>(param: &'static str, v: T, min: T) -> Result<(), ConfigError> {
-    finite(param, v)?;
-    if v > min {
-        Ok(())
-    } else {
-        Err(ConfigError::new(param, v, Rule::BandInverted))
-    }
-}
-
-/// What a parameter violates.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub enum Rule {
-    /// NaN or infinite.
-    NotFinite,
-    /// Must be > 0.
-    NotPositive,
-    /// Must be ≥ 0.
-    Negative,
-    /// A lower bound is not below its upper bound.
-    BandInverted,
-    /// Outside the configured envelope.
-    OutsideEnvelope,
-    /// An angle on the wrong side of the vertical for its stage (Eq. 33).
-    WrongQuadrant,
-    /// ρ × maximum length ≥ m01.
-    TetherHeavierThanSatellite,
-}
-
-/// A rejected parameter: its name (the field path in [`Config`]), its value and the rule.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub struct ConfigError {
-    /// Field path, e.g. `gains.k1_per_s`.
-    pub param: &'static str,
-    /// The offending value (widened to f64).
-    pub value: f64,
-    /// The rule it breaks.
-    pub rule: Rule,
-}
-
-impl ConfigError {
-    fn new<T: Real>(param: &'static str, value: T, rule: Rule) -> Self {
-        Self {
-            param,
-            value: value.to_f64(),
-            rule,
-        }
-    }
-}
-
-impl core::fmt::Display for ConfigError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(
-            f,
-            "invalid parameter {} = {}: {:?}",
-            self.param, self.value, self.rule
-        )
-    }
-}
+pub use crate::config::{Config, ConfigError, Rule, Stage1Config, Stage2Config};
+pub use crate::envelope::Envelope;
+pub use crate::monitor::{MonitorConfig, Sensor};
 
 /// One control period's sensor sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -329,28 +66,34 @@ pub enum Phase {
     Keep2,
 }
 
-/// Which sensed value was rejected.
+/// Health of the controller's inputs: the fault state machine.
+///
+/// ```text
+///            bad sample / law fault                more than coast_ticks bad
+///   Nominal ─────────────────────────▶ Degraded ───────────────────────────▶ SafeHold
+///      ▲ ◀──────── next good sample ───────┘                                    │
+///      └──────────────── recovery_ticks good samples in a row ──────────────────┘
+///                        (the Eq. 29 blend restarts from the current rate)
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub enum Sensor {
-    /// Tether length.
-    Length,
-    /// In-plane angle.
-    Alpha,
-    /// In-plane rate.
-    AlphaRate,
-    /// Orbit rate.
-    OrbitRate,
-    /// The tick count went backwards.
-    Tick,
+pub enum Health {
+    /// Valid samples; the law commands the reel.
+    Nominal,
+    /// No usable sample (or no law solution) for at most `coast_ticks`: the reel coasts on its
+    /// last command while the length is predicted from the integrated command.
+    Degraded,
+    /// Too long without a usable sample: the rate is ramped to zero within the acceleration
+    /// limit and held there until the sensors recover.
+    SafeHold,
 }
 
-/// Why this step's command is a safe action rather than the law's value.
+/// Why this step's command is not the law's value.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub enum Fault {
-    /// A sensed value is NaN, infinite or outside its physical range.
-    InvalidInput(Sensor),
+    /// A sample was missing or rejected.
+    Sensor(Sensor),
     /// The law is at one of its singular points.
     Law(LawFault),
 }
@@ -367,12 +110,18 @@ impl Flags {
     pub const ACCEL_SATURATED: u32 = 1 << 1;
     /// A length limit (docking or spool) restricted the command.
     pub const LENGTH_LIMITED: u32 = 1 << 2;
-    /// The command is a safe action because of a fault (see [`Output::fault`]).
+    /// The command is a safe action, not the law's value (see [`Output::fault`]).
     pub const SAFE_ACTION: u32 = 1 << 3;
-    /// The blend (Eq. 29) restarted at this step (a stage began).
+    /// The blend (Eq. 29) restarted at this step (a stage began, or the controller recovered).
     pub const BLEND_RESTART: u32 = 1 << 4;
     /// α_r is slewing (stage 2 start).
     pub const SLEWING: u32 = 1 << 5;
+    /// [`Output::health`] changed at this step.
+    pub const HEALTH_CHANGED: u32 = 1 << 6;
+    /// The commanded l̇/l lies outside the region where an equilibrium exists over the whole
+    /// orbit (Eq. 13; see [`Output::equilibrium_margin`]). Reported, not acted on: the paper's
+    /// own deployment starts far outside it (l̇/l = 0.1 s⁻¹ at l = 1 m).
+    pub const NO_EQUILIBRIUM: u32 = 1 << 7;
 
     /// `true` if every bit of `mask` is set.
     pub fn contains(self, mask: u32) -> bool {
@@ -380,6 +129,11 @@ impl Flags {
     }
     fn set(&mut self, mask: u32) {
         self.0 |= mask;
+    }
+    fn set_if(&mut self, cond: bool, mask: u32) {
+        if cond {
+            self.set(mask);
+        }
     }
 }
 
@@ -391,11 +145,14 @@ pub struct Output<T> {
     pub tick: u32,
     /// Mission phase after this step.
     pub phase: Phase,
-    /// Reel-rate command l̇_real for the coming period, m/s (inside the envelope, finite).
+    /// Input health after this step.
+    pub health: Health,
+    /// Reel-rate command l̇_real for the coming period, m/s (finite, inside the envelope).
     pub rate_cmd_mps: T,
-    /// Commanded reel acceleration (Eq. 30, sign corrected), m/s².
+    /// Commanded reel acceleration (Eq. 30, sign corrected; the ramp's slope when a limit or
+    /// safe action shapes the command), m/s².
     pub accel_cmd_mps2: T,
-    /// The Eq. 27 value l̇ before the blend, m/s (0 when the law has no value).
+    /// The Eq. 27 value l̇ before the blend, m/s (0 when the law did not run).
     pub law_rate_mps: T,
     /// Blend weight E = e^{−cτ} of Eq. 29.
     pub blend_weight: T,
@@ -403,24 +160,20 @@ pub struct Output<T> {
     pub alpha_ref_rad: T,
     /// α̇_r = (∂α_r/∂l) l̇_real + ∂α_r/∂t, rad/s.
     pub alpha_ref_rate_radps: T,
-    /// δ = α − α_r, rad.
+    /// δ = α − α_r, rad (0 when the law did not run).
     pub delta_rad: T,
-    /// δ̇ = α̇ − α̇_r, rad/s.
+    /// δ̇ = α̇ − α̇_r, rad/s (0 when the law did not run).
     pub delta_rate_radps: T,
+    /// The length the controller works with: the sensed one, or the prediction from the
+    /// integrated command while coasting, m.
+    pub length_estimate_m: T,
+    /// Signed margin of the commanded x = (2+μ3) l̇/(ωl) inside the whole-orbit existence
+    /// region [max Retr, min Depl] of Eq. 13: > 0 inside, < 0 outside (dimensionless).
+    pub equilibrium_margin: T,
     /// Status bits.
     pub flags: Flags,
     /// The fault behind a safe action, if any.
     pub fault: Option<Fault>,
-}
-
-/// Physical plausibility limits of the sensed inputs (beyond which a value is a sensor fault).
-mod limits {
-    /// |α̇| above this is not a tether swing (≈ 60 × orbit rate), rad/s.
-    pub const MAX_ALPHA_RATE_RADPS: f64 = 0.06;
-    /// Orbit rates outside (0, this] are not an Earth orbit (LEO ≈ 1.2e-3), rad/s.
-    pub const MAX_ORBIT_RATE_RADPS: f64 = 1.0e-2;
-    /// A sensed length beyond the spool by more than this fraction is a sensor fault.
-    pub const LENGTH_MARGIN: f64 = 0.05;
 }
 
 /// The reel controller (see the module docs for a complete example).
@@ -428,12 +181,32 @@ mod limits {
 pub struct Controller<T> {
     cfg: Config<T>,
     stage2: bool,
+    stage2_requested: bool,
     stage_start_tick: u32,
-    stage_initial_rate_mps: T,
+    blend_start_tick: u32,
+    blend_initial_rate_mps: T,
     phase: Phase,
+    health: Health,
+    /// Consecutive ticks without a usable sample or law solution.
+    bad_ticks: u32,
+    /// Consecutive valid samples while in safe hold.
+    good_ticks: u32,
     last_tick: Option<u32>,
     last_rate_cmd_mps: T,
-    stage2_requested: bool,
+    length_estimate_m: T,
+    monitor: Monitor<T>,
+    existence: ExistenceMonitor<T>,
+}
+
+/// The law's contribution to an output.
+struct LawPart<T> {
+    reference: Reference<T>,
+    rate_mps: T,
+    accel_mps2: T,
+    law_rate_mps: T,
+    ref_rate_radps: T,
+    delta_rad: T,
+    delta_rate_radps: T,
 }
 
 impl<T: Real> Controller<T> {
@@ -441,14 +214,24 @@ impl<T: Real> Controller<T> {
     /// one.
     pub fn new(cfg: Config<T>) -> Result<Self, ConfigError> {
         cfg.validate()?;
+        let existence = ExistenceMonitor::from_orbit(&cfg.orbit).map_err(|_| {
+            ConfigError::new("orbit.eccentricity", cfg.orbit.eccentricity, Rule::NoEquilibrium)
+        })?;
         Ok(Self {
+            existence,
             stage2: false,
+            stage2_requested: false,
             stage_start_tick: 0,
-            stage_initial_rate_mps: cfg.initial_rate_mps,
+            blend_start_tick: 0,
+            blend_initial_rate_mps: cfg.initial_rate_mps,
             phase: Phase::Deploy,
+            health: Health::Nominal,
+            bad_ticks: 0,
+            good_ticks: 0,
             last_tick: None,
             last_rate_cmd_mps: cfg.initial_rate_mps,
-            stage2_requested: false,
+            length_estimate_m: T::ZERO,
+            monitor: Monitor::new(),
             cfg,
         })
     }
@@ -463,108 +246,139 @@ impl<T: Real> Controller<T> {
         self.phase
     }
 
+    /// The current input health.
+    pub fn health(&self) -> Health {
+        self.health
+    }
+
     /// Asks for stage 2 (retrieval) to begin at the next step, whatever the configured start.
     pub fn start_stage2(&mut self) {
         self.stage2_requested = true;
     }
 
-    /// One control period: validates the sample, runs the sequencer, the reference, the law
-    /// and the envelope, and returns the command with its explanation.
+    /// One control period with a fresh sensor sample.
     pub fn step(&mut self, input: &Input<T>) -> Output<T> {
-        let mut flags = Flags::default();
-        let tick = input.tick;
+        self.advance(input.tick, Some(input))
+    }
 
-        // Sequencer: stage 2 starts at its tick or on command; the blend restarts from the
-        // current rate so the command is continuous (SPEC §7).
+    /// One control period in which no sample arrived (a sensor dropout): the controller coasts
+    /// on the predicted length, then goes to safe hold (see [`Health`]).
+    pub fn step_missing(&mut self, tick: u32) -> Output<T> {
+        self.advance(tick, None)
+    }
+
+    fn advance(&mut self, tick: u32, sample: Option<&Input<T>>) -> Output<T> {
+        let mut flags = Flags::default();
+        let dt = self.cfg.period_s;
+        // A tick that goes backwards is a bad sample; time does not move.
+        let elapsed_ticks = match self.last_tick {
+            None => 0,
+            Some(last) if tick >= last => tick - last,
+            Some(_) => return self.reject(tick, Fault::Sensor(Sensor::Tick), None, flags),
+        };
+        let first = self.last_tick.is_none();
+        self.last_tick = Some(tick);
+        let elapsed_s = T::from_u32(elapsed_ticks.max(1)) * dt;
+        // Dead reckoning: the reel ran at the last command since the last step.
+        self.length_estimate_m = self.length_estimate_m + self.last_rate_cmd_mps * T::from_u32(elapsed_ticks) * dt;
+
+        // Sequencer: stage 1 starts with the first step; stage 2 at its tick or on command.
+        // Each stage restarts the blend from the current rate (SPEC §7).
+        if first {
+            self.stage_start_tick = tick;
+            self.restart_blend(tick, self.cfg.initial_rate_mps, &mut flags);
+        }
         let due = self.cfg.stage2.start_tick.is_some_and(|s| tick >= s);
         if !self.stage2 && (due || self.stage2_requested) {
             self.stage2 = true;
             self.stage_start_tick = tick;
-            self.stage_initial_rate_mps = self.last_rate_cmd_mps;
+            self.restart_blend(tick, self.last_rate_cmd_mps, &mut flags);
             self.phase = Phase::Slew;
-            flags.set(Flags::BLEND_RESTART);
-        } else if !self.stage2 && self.last_tick.is_none() {
-            self.stage_start_tick = tick;
-            flags.set(Flags::BLEND_RESTART);
         }
 
-        let tau_s = T::from_u32(tick.saturating_sub(self.stage_start_tick)) * self.cfg.period_s;
-        let decay = if self.stage2 {
-            self.cfg.stage2.decay_rate_per_s
-        } else {
-            self.cfg.stage1.decay_rate_per_s
+        let Some(x) = sample else {
+            return self.reject(tick, Fault::Sensor(Sensor::Missing), None, flags);
         };
-        let blend_weight = (-decay * tau_s).exp();
+        // In safe hold the prediction is not trusted; the first sample re-anchors it.
+        let expected = match (first, self.health) {
+            (true, _) | (_, Health::SafeHold) => None,
+            _ => Some(self.length_estimate_m),
+        };
+        let env = self.cfg.envelope;
+        if let Err(s) = self.monitor.check(&self.cfg.monitor, x, expected, env.max_length_m, dt) {
+            return self.reject(tick, Fault::Sensor(s), None, flags);
+        }
+        self.length_estimate_m = x.length_m;
 
-        let reference = match self.check_input(input) {
-            Ok(()) => self.reference(tau_s, input.length_m),
-            Err(sensor) => {
-                self.last_tick = Some(tick.max(self.last_tick.unwrap_or(0)));
-                return self.safe_action(
-                    tick,
-                    blend_weight,
-                    None,
-                    flags,
-                    Fault::InvalidInput(sensor),
-                );
+        let tau_s = T::from_u32(tick.saturating_sub(self.stage_start_tick)) * dt;
+        let reference = self.reference(tau_s, x.length_m);
+        if self.health == Health::SafeHold {
+            self.good_ticks = self.good_ticks.saturating_add(1);
+            if self.good_ticks < self.cfg.monitor.recovery_ticks {
+                let hold = self.hold(tick, &reference, flags, None);
+                return hold;
             }
-        };
-        if reference.slewing {
-            flags.set(Flags::SLEWING);
+            // Recovered: re-engage the law through the Eq. 29 blend from the current rate.
+            self.restart_blend(tick, self.last_rate_cmd_mps, &mut flags);
         }
-        self.last_tick = Some(tick);
-
-        let mass = self.cfg.masses;
-        let l = input.length_m;
-        let c = mass.coefficients(l);
-        let law_in = LawInput {
-            length_m: l,
-            alpha_rad: input.alpha_rad,
-            alpha_rate_radps: input.alpha_rate_radps,
-            orbit_rate_radps: input.orbit_rate_radps,
-            ref_angle_rad: reference.angle.angle_rad,
-            ref_slope_rad_per_m: reference.angle.slope_rad_per_m,
-            ref_curvature_rad_per_m2: reference.angle.curvature_rad_per_m2,
-            ref_time_rate_radps: reference.time_rate_radps,
-            mu3: c.mu3,
-            mu3_per_m: mass.mu3_rate_per_s(l, T::ONE),
-            blend_weight,
-            decay_rate_per_s: decay,
-            initial_rate_mps: self.stage_initial_rate_mps,
-            gains: self.cfg.gains,
-        };
-        let solved =
-            law::solve(&law_in).and_then(|s| law::acceleration(&law_in, &s).map(|a| (s, a)));
-        let (sol, accel) = match solved {
+        let law = match self.solve(x, &reference) {
             Ok(v) => v,
-            Err(f) => {
-                return self.safe_action(tick, blend_weight, Some(&reference), flags, Fault::Law(f))
-            }
+            Err(f) => return self.reject(tick, Fault::Law(f), Some(&reference), flags),
         };
+        self.set_health(Health::Nominal, &mut flags);
+        self.bad_ticks = 0;
 
-        let rate = self.limit(sol.rate_mps, l, &mut flags);
-        let limited = rate != sol.rate_mps;
-        let accel_cmd = if limited {
-            (rate - self.last_rate_cmd_mps) / self.cfg.period_s
+        let (rate, sat) = env.limit(law.rate_mps, self.last_rate_cmd_mps, x.length_m, elapsed_s);
+        let limited = sat != Saturation::default();
+        flags.set_if(sat.rate, Flags::RATE_SATURATED);
+        flags.set_if(sat.accel, Flags::ACCEL_SATURATED);
+        flags.set_if(sat.length, Flags::LENGTH_LIMITED);
+        flags.set_if(law.reference.slewing, Flags::SLEWING);
+        let accel = if limited {
+            (rate - self.last_rate_cmd_mps) / elapsed_s
         } else {
-            accel
+            law.accel_mps2
         };
         self.last_rate_cmd_mps = rate;
-        self.update_phase(l, reference.slewing);
+        self.update_phase(x.length_m, law.reference.slewing);
+        let margin = self.equilibrium_margin(x.length_m, rate, &mut flags);
         Output {
             tick,
             phase: self.phase,
+            health: self.health,
             rate_cmd_mps: rate,
-            accel_cmd_mps2: accel_cmd,
-            law_rate_mps: sol.law_rate_mps,
-            blend_weight,
-            alpha_ref_rad: reference.angle.angle_rad,
-            alpha_ref_rate_radps: sol.ref_rate_radps,
-            delta_rad: sol.delta_rad,
-            delta_rate_radps: sol.delta_rate_radps,
+            accel_cmd_mps2: accel,
+            law_rate_mps: law.law_rate_mps,
+            blend_weight: self.blend_weight(tick),
+            alpha_ref_rad: law.reference.angle.angle_rad,
+            alpha_ref_rate_radps: law.ref_rate_radps,
+            delta_rad: law.delta_rad,
+            delta_rate_radps: law.delta_rate_radps,
+            length_estimate_m: self.length_estimate_m,
+            equilibrium_margin: margin,
             flags,
             fault: None,
         }
+    }
+
+    fn restart_blend(&mut self, tick: u32, rate_mps: T, flags: &mut Flags) {
+        self.blend_start_tick = tick;
+        self.blend_initial_rate_mps = rate_mps;
+        flags.set(Flags::BLEND_RESTART);
+    }
+
+    fn decay_rate_per_s(&self) -> T {
+        if self.stage2 {
+            self.cfg.stage2.decay_rate_per_s
+        } else {
+            self.cfg.stage1.decay_rate_per_s
+        }
+    }
+
+    /// E = e^{−cτ}, τ = time since the blend (re)started (Eq. 29).
+    fn blend_weight(&self, tick: u32) -> T {
+        let tau_s = T::from_u32(tick.saturating_sub(self.blend_start_tick)) * self.cfg.period_s;
+        (-self.decay_rate_per_s() * tau_s).exp()
     }
 
     fn reference(&self, tau_s: T, length_m: T) -> Reference<T> {
@@ -583,105 +397,126 @@ impl<T: Real> Controller<T> {
         }
     }
 
-    fn check_input(&self, x: &Input<T>) -> Result<(), Sensor> {
-        let env = &self.cfg.envelope;
-        let max_len = env.max_length_m * (T::ONE + T::from_f64(limits::LENGTH_MARGIN));
-        let pi = T::from_f64(core::f64::consts::PI);
-        if self.last_tick.is_some_and(|t| x.tick < t) {
-            return Err(Sensor::Tick);
-        }
-        if !(x.length_m.is_finite() && x.length_m > T::ZERO && x.length_m <= max_len) {
-            return Err(Sensor::Length);
-        }
-        if !(x.alpha_rad.is_finite() && x.alpha_rad.abs() <= pi) {
-            return Err(Sensor::Alpha);
-        }
-        if !(x.alpha_rate_radps.is_finite()
-            && x.alpha_rate_radps.abs() <= T::from_f64(limits::MAX_ALPHA_RATE_RADPS))
-        {
-            return Err(Sensor::AlphaRate);
-        }
-        if !(x.orbit_rate_radps.is_finite()
-            && x.orbit_rate_radps > T::ZERO
-            && x.orbit_rate_radps <= T::from_f64(limits::MAX_ORBIT_RATE_RADPS))
-        {
-            return Err(Sensor::OrbitRate);
-        }
-        Ok(())
-    }
-
-    /// Rate limit, then the hard length limits (which win), then the acceleration limit
-    /// unless a length limit had to act.
-    fn limit(&self, rate: T, length_m: T, flags: &mut Flags) -> T {
-        let env = &self.cfg.envelope;
-        let dt = self.cfg.period_s;
-        let mut y = rate;
-        if y.abs() > env.max_rate_mps {
-            flags.set(Flags::RATE_SATURATED);
-            y = y.clamp_to(-env.max_rate_mps, env.max_rate_mps);
-        }
-        let step = env.max_accel_mps2 * dt;
-        let prev = self.last_rate_cmd_mps;
-        if (y - prev).abs() > step {
-            flags.set(Flags::ACCEL_SATURATED);
-            y = y.clamp_to(prev - step, prev + step);
-        }
-        let up = (env.max_length_m - length_m) / dt;
-        let down = (env.min_length_m - length_m) / dt;
-        if y > up || y < down {
-            flags.set(Flags::LENGTH_LIMITED);
-            y = y.clamp_to(down.min(up), up.max(down));
-        }
-        y
-    }
-
-    /// The documented safe action: the previous command ramped toward zero at the
-    /// acceleration limit (and inside the length limits as far as they are known).
-    fn safe_action(
-        &mut self,
-        tick: u32,
-        blend_weight: T,
-        reference: Option<&Reference<T>>,
-        mut flags: Flags,
-        fault: Fault,
-    ) -> Output<T> {
-        flags.set(Flags::SAFE_ACTION);
-        let step = self.cfg.envelope.max_accel_mps2 * self.cfg.period_s;
-        let prev = self.last_rate_cmd_mps;
-        let rate = if prev.abs() <= step {
-            T::ZERO
-        } else if prev > T::ZERO {
-            prev - step
-        } else {
-            prev + step
+    /// Eqs. 27 + 29 solved implicitly, and the Eq. 30 acceleration (SPEC §5).
+    fn solve(&self, x: &Input<T>, reference: &Reference<T>) -> Result<LawPart<T>, LawFault> {
+        let mass = self.cfg.masses;
+        let l = x.length_m;
+        let law_in = LawInput {
+            length_m: l,
+            alpha_rad: x.alpha_rad,
+            alpha_rate_radps: x.alpha_rate_radps,
+            orbit_rate_radps: x.orbit_rate_radps,
+            ref_angle_rad: reference.angle.angle_rad,
+            ref_slope_rad_per_m: reference.angle.slope_rad_per_m,
+            ref_curvature_rad_per_m2: reference.angle.curvature_rad_per_m2,
+            ref_time_rate_radps: reference.time_rate_radps,
+            mu3: mass.coefficients(l).mu3,
+            mu3_per_m: mass.mu3_rate_per_s(l, T::ONE),
+            blend_weight: self.blend_weight(x.tick),
+            decay_rate_per_s: self.decay_rate_per_s(),
+            initial_rate_mps: self.blend_initial_rate_mps,
+            gains: self.cfg.gains,
         };
+        let s = law::solve(&law_in)?;
+        let accel = law::acceleration(&law_in, &s)?;
+        Ok(LawPart {
+            reference: *reference,
+            rate_mps: s.rate_mps,
+            accel_mps2: accel,
+            law_rate_mps: s.law_rate_mps,
+            ref_rate_radps: s.ref_rate_radps,
+            delta_rad: s.delta_rad,
+            delta_rate_radps: s.delta_rate_radps,
+        })
+    }
+
+    fn set_health(&mut self, h: Health, flags: &mut Flags) {
+        if self.health != h {
+            self.health = h;
+            flags.set(Flags::HEALTH_CHANGED);
+        }
+        if h != Health::SafeHold {
+            self.good_ticks = 0;
+        }
+    }
+
+    /// No usable sample or no law solution at this tick: coast (Degraded) for up to
+    /// `coast_ticks`, then safe hold.
+    fn reject(&mut self, tick: u32, fault: Fault, reference: Option<&Reference<T>>, mut flags: Flags) -> Output<T> {
+        self.bad_ticks = self.bad_ticks.saturating_add(1);
+        let next = if self.health == Health::SafeHold || self.bad_ticks > self.cfg.monitor.coast_ticks {
+            Health::SafeHold
+        } else {
+            Health::Degraded
+        };
+        self.set_health(next, &mut flags);
+        self.good_ticks = 0;
+        let fallback = Reference {
+            angle: crate::schedule::RefAngle {
+                angle_rad: T::ZERO,
+                slope_rad_per_m: T::ZERO,
+                curvature_rad_per_m2: T::ZERO,
+            },
+            time_rate_radps: T::ZERO,
+            slewing: false,
+        };
+        self.hold(tick, reference.unwrap_or(&fallback), flags, Some(fault))
+    }
+
+    /// The safe actions. Degraded: keep the last command (coast). Safe hold: ramp the rate to
+    /// zero at the acceleration limit. Both stay inside the length limits, judged on the
+    /// predicted length.
+    fn hold(&mut self, tick: u32, reference: &Reference<T>, mut flags: Flags, fault: Option<Fault>) -> Output<T> {
+        flags.set(Flags::SAFE_ACTION);
+        let dt = self.cfg.period_s;
+        let prev = self.last_rate_cmd_mps;
+        let target = if self.health == Health::Degraded { prev } else { T::ZERO };
+        let (rate, sat) = self.cfg.envelope.limit(target, prev, self.length_estimate_m, dt);
+        flags.set_if(sat.length, Flags::LENGTH_LIMITED);
         self.last_rate_cmd_mps = rate;
+        let margin = self.equilibrium_margin(self.length_estimate_m, rate, &mut flags);
         Output {
             tick,
             phase: self.phase,
+            health: self.health,
             rate_cmd_mps: rate,
-            accel_cmd_mps2: (rate - prev) / self.cfg.period_s,
+            accel_cmd_mps2: (rate - prev) / dt,
             law_rate_mps: T::ZERO,
-            blend_weight,
-            alpha_ref_rad: reference.map_or(T::ZERO, |r| r.angle.angle_rad),
+            blend_weight: self.blend_weight(tick),
+            alpha_ref_rad: reference.angle.angle_rad,
             alpha_ref_rate_radps: T::ZERO,
             delta_rad: T::ZERO,
             delta_rate_radps: T::ZERO,
+            length_estimate_m: self.length_estimate_m,
+            equilibrium_margin: margin,
             flags,
-            fault: Some(fault),
+            fault,
+        }
+    }
+
+    /// The Eq. 13 margin of the command (whole orbit), flagging a command outside the region.
+    fn equilibrium_margin(&self, length_m: T, rate_mps: T, flags: &mut Flags) -> T {
+        let mu3 = self.cfg.masses.coefficients(length_m).mu3;
+        match self.existence.check_rate(Anomaly::WholeOrbit, mu3, length_m, rate_mps) {
+            Ok(c) => {
+                flags.set_if(!c.exists, Flags::NO_EQUILIBRIUM);
+                c.margin
+            }
+            // Only a non-positive or non-finite length estimate gets here (a long coast
+            // toward docking): no equilibrium statement can be made.
+            Err(_) => {
+                flags.set(Flags::NO_EQUILIBRIUM);
+                T::ZERO
+            }
         }
     }
 
     fn update_phase(&mut self, length_m: T, slewing: bool) {
         let capture = self.cfg.keep_capture_m;
         self.phase = match self.phase {
-            Phase::Deploy if length_m >= self.cfg.stage1.schedule.high_length_m - capture => {
-                Phase::Keep1
-            }
+            Phase::Deploy if length_m >= self.cfg.stage1.schedule.high_length_m - capture => Phase::Keep1,
             Phase::Slew if !slewing => Phase::Retrieve,
-            Phase::Retrieve if length_m <= self.cfg.stage2.schedule.low_length_m + capture => {
-                Phase::Keep2
-            }
+            Phase::Retrieve if length_m <= self.cfg.stage2.schedule.low_length_m + capture => Phase::Keep2,
             p => p,
         };
     }

@@ -8,10 +8,16 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod config;
+pub mod controller;
+pub mod envelope;
 pub mod equilibrium;
+pub mod law;
 pub mod mass;
+pub mod monitor;
 pub mod orbit;
 pub mod real;
+pub mod schedule;
 pub mod stability;
 
 pub use real::Real;

@@ -8,7 +8,8 @@ use crate::history::{History, PhaseLabel, Sample};
 use crate::plant::{ix, Plant, State};
 use crate::scenario::Scenario;
 use tss_reel::controller::{
-    Config, ConfigError, Controller, Envelope, Input, Output, Phase, Stage1Config, Stage2Config,
+    Config, ConfigError, Controller, Envelope, Input, MonitorConfig, Output, Phase, Stage1Config,
+    Stage2Config,
 };
 use tss_reel::law::Gains;
 use tss_reel::mass::MassModel;
@@ -47,6 +48,7 @@ pub fn controller_config<T: Real>(sc: &Scenario) -> Result<Config<T>, SimError> 
     let stage2_tick = ticks("stage2.start_time_s", sc.stage2.start_time_s, period)?;
     Ok(Config {
         period_s: f(period),
+        orbit: Orbit::elliptic(f(sc.orbit.semi_major_axis_m), f(sc.orbit.eccentricity)),
         masses: mass_model(sc),
         gains: Gains {
             k1_per_s: f(sc.controller.k1_per_s),
@@ -84,6 +86,7 @@ pub fn controller_config<T: Real>(sc: &Scenario) -> Result<Config<T>, SimError> 
             min_length_m: f(sc.envelope.min_length_m),
             max_length_m: f(sc.envelope.max_length_m),
         },
+        monitor: MonitorConfig::default_for_period(),
     })
 }
 

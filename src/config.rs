@@ -1,0 +1,287 @@
+//! Controller parameters and their validation.
+//!
+//! Every parameter is checked once, when the controller is built ([`Config::validate`], called
+//! by [`crate::controller::Controller::new`]): a controller that exists is a valid one. Errors
+//! are typed and name the parameter (its path in [`Config`]) and the value.
+
+use crate::envelope::Envelope;
+use crate::law::Gains;
+use crate::mass::MassModel;
+use crate::monitor::MonitorConfig;
+use crate::orbit::Orbit;
+use crate::real::Real;
+use crate::schedule::BandSchedule;
+
+/// Stage 1 (Eq. 34): deploy, then keep.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stage1Config<T> {
+    /// The Eq. 34 reference schedule; its `high_length_m` is the keep length.
+    pub schedule: BandSchedule<T>,
+    /// c of Eq. 29 in stage 1, 1/s.
+    pub decay_rate_per_s: T,
+}
+
+/// Stage 2 (slew, then Eq. 35): retrieve, then keep.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stage2Config<T> {
+    /// The Eq. 35 reference schedule; its `low_length_m` is the keep length.
+    pub schedule: BandSchedule<T>,
+    /// Slew rate of α_r from 0 to the plateau at the stage start, rad/s.
+    pub slew_rate_radps: T,
+    /// c of Eq. 29 in stage 2, 1/s.
+    pub decay_rate_per_s: T,
+    /// Tick at which stage 2 starts by itself; `None` waits for [`Controller::start_stage2`].
+    pub start_tick: Option<u32>,
+}
+
+/// Everything that defines a controller. Validated once by [`Controller::new`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Config<T> {
+    /// Control period, s (one tick).
+    pub period_s: T,
+    /// The orbit of the centre of mass, for the onboard existence check (Eqs. 9, 13).
+    pub orbit: Orbit<T>,
+    /// Masses (for μ3 of Eq. 27).
+    pub masses: MassModel<T>,
+    /// k1, k2 of Eq. 27.
+    pub gains: Gains<T>,
+    /// l̇0 of stage 1: the reel's rate at release, m/s (Eq. 29).
+    pub initial_rate_mps: T,
+    /// Stage 1.
+    pub stage1: Stage1Config<T>,
+    /// Stage 2.
+    pub stage2: Stage2Config<T>,
+    /// A keep phase is entered when l comes within this distance of its keep length, m.
+    pub keep_capture_m: T,
+    /// Rate, acceleration and length limits.
+    pub envelope: Envelope<T>,
+    /// Sensor checks and fault timing.
+    pub monitor: MonitorConfig<T>,
+}
+
+impl<T: Real> Config<T> {
+    /// The paper's Section 6 (SPEC §7): 1 s period, ρ = 0, l̇0 = 0.1 m/s, k1 = 0.0057 s⁻¹,
+    /// k2 = 9.8696e-6 s⁻², c = 1e-3 s⁻¹ then 5e-4 s⁻¹, slew 6.2932e-4 rad/s, stage 2 at
+    /// t = 8 h.
+    ///
+    /// The envelope (15 m/s, 15 m/s², 0.5 m to 40 km) is wide enough never to act in the
+    /// paper's mission, which had no reel limits: its law peaks at 13.1 m/s and steps the rate
+    /// by 11.8 m/s in one second when the stage-2 slew hands over to Eq. 35 (α̇_r drops from
+    /// the slew rate to 0). A real reel needs a tighter envelope; see
+    /// `scenarios/paper-reel-limits.toml`.
+    pub fn paper() -> Self {
+        Self {
+            period_s: T::ONE,
+            orbit: Orbit::circular(T::from_f64(7_078_000.0)),
+            masses: MassModel::paper(),
+            gains: Gains::paper(),
+            initial_rate_mps: T::from_f64(0.1),
+            stage1: Stage1Config {
+                schedule: BandSchedule::paper_stage1(),
+                decay_rate_per_s: T::from_f64(1e-3),
+            },
+            stage2: Stage2Config {
+                schedule: BandSchedule::paper_stage2(),
+                slew_rate_radps: T::from_f64(6.2932e-4),
+                decay_rate_per_s: T::from_f64(5e-4),
+                start_tick: Some(8 * 3600),
+            },
+            keep_capture_m: T::ONE,
+            envelope: Envelope {
+                max_rate_mps: T::from_f64(15.0),
+                max_accel_mps2: T::from_f64(15.0),
+                min_length_m: T::from_f64(0.5),
+                max_length_m: T::from_f64(40_000.0),
+            },
+            monitor: MonitorConfig::default_for_period(),
+        }
+    }
+
+    /// Checks every parameter; the first violation is returned.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let z = T::ZERO;
+        positive("period_s", self.period_s)?;
+        positive("orbit.semi_major_axis_m", self.orbit.semi_major_axis_m)?;
+        positive("orbit.mu_m3ps2", self.orbit.mu_m3ps2)?;
+        // Equilibria exist over the whole orbit only for e < 0.75 (Eq. 13, Theorem 1).
+        let e = self.orbit.eccentricity;
+        at_least("orbit.eccentricity", e, T::ZERO)?;
+        if e >= T::from_f64(0.75) {
+            return Err(ConfigError::new("orbit.eccentricity", e, Rule::NoEquilibrium));
+        }
+        positive("masses.main_initial_kg", self.masses.main_initial_kg)?;
+        positive("masses.sub_kg", self.masses.sub_kg)?;
+        at_least(
+            "masses.tether_density_kg_per_m",
+            self.masses.tether_density_kg_per_m,
+            z,
+        )?;
+        positive("gains.k1_per_s", self.gains.k1_per_s)?;
+        positive("gains.k2_per_s2", self.gains.k2_per_s2)?;
+        at_least("stage1.decay_rate_per_s", self.stage1.decay_rate_per_s, z)?;
+        at_least("stage2.decay_rate_per_s", self.stage2.decay_rate_per_s, z)?;
+        positive("stage2.slew_rate_radps", self.stage2.slew_rate_radps)?;
+        positive("keep_capture_m", self.keep_capture_m)?;
+        let env = &self.envelope;
+        self.monitor.validate()?;
+        positive("envelope.max_rate_mps", env.max_rate_mps)?;
+        positive("envelope.max_accel_mps2", env.max_accel_mps2)?;
+        positive("envelope.min_length_m", env.min_length_m)?;
+        above("envelope.max_length_m", env.max_length_m, env.min_length_m)?;
+        finite("initial_rate_mps", self.initial_rate_mps)?;
+        if self.initial_rate_mps.abs() > env.max_rate_mps {
+            return Err(ConfigError::new(
+                "initial_rate_mps",
+                self.initial_rate_mps,
+                Rule::OutsideEnvelope,
+            ));
+        }
+        // The whole tether must weigh less than the main satellite that carries it.
+        let tether_kg = self.masses.tether_density_kg_per_m * env.max_length_m;
+        if tether_kg >= self.masses.main_initial_kg {
+            return Err(ConfigError::new(
+                "masses.tether_density_kg_per_m",
+                self.masses.tether_density_kg_per_m,
+                Rule::TetherHeavierThanSatellite,
+            ));
+        }
+        for (name, s) in [
+            ("stage1.schedule", &self.stage1.schedule),
+            ("stage2.schedule", &self.stage2.schedule),
+        ] {
+            for v in [
+                s.low_length_m,
+                s.low_angle_rad,
+                s.low_slope_rad_per_m,
+                s.high_length_m,
+                s.high_angle_rad,
+                s.high_slope_rad_per_m,
+            ] {
+                finite(name, v)?;
+            }
+            if s.low_length_m >= s.high_length_m {
+                return Err(ConfigError::new(name, s.low_length_m, Rule::BandInverted));
+            }
+        }
+        // Deployment needs α_r on the deployment side, (−π/2, 0) (Eq. 33, SPEC §9.5);
+        // retrieval on the retrieval side, (0, π/2).
+        let half_pi = T::from_f64(core::f64::consts::FRAC_PI_2);
+        let deploy = self.stage1.schedule.low_angle_rad;
+        if !(deploy < z && deploy > -half_pi) {
+            return Err(ConfigError::new(
+                "stage1.schedule.low_angle_rad",
+                deploy,
+                Rule::WrongQuadrant,
+            ));
+        }
+        let retrieve = self.stage2.schedule.high_angle_rad;
+        if !(retrieve > z && retrieve < half_pi) {
+            return Err(ConfigError::new(
+                "stage2.schedule.high_angle_rad",
+                retrieve,
+                Rule::WrongQuadrant,
+            ));
+        }
+        let keep1 = self.stage1.schedule.high_length_m;
+        let keep2 = self.stage2.schedule.low_length_m;
+        for (name, v) in [
+            ("stage1.schedule.high_length_m", keep1),
+            ("stage2.schedule.low_length_m", keep2),
+        ] {
+            if !(v > env.min_length_m && v < env.max_length_m) {
+                return Err(ConfigError::new(name, v, Rule::OutsideEnvelope));
+            }
+        }
+        Ok(())
+    }
+}
+
+pub(crate) fn finite<T: Real>(param: &'static str, v: T) -> Result<(), ConfigError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(ConfigError::new(param, v, Rule::NotFinite))
+    }
+}
+
+pub(crate) fn positive<T: Real>(param: &'static str, v: T) -> Result<(), ConfigError> {
+    finite(param, v)?;
+    if v > T::ZERO {
+        Ok(())
+    } else {
+        Err(ConfigError::new(param, v, Rule::NotPositive))
+    }
+}
+
+pub(crate) fn at_least<T: Real>(param: &'static str, v: T, min: T) -> Result<(), ConfigError> {
+    finite(param, v)?;
+    if v >= min {
+        Ok(())
+    } else {
+        Err(ConfigError::new(param, v, Rule::Negative))
+    }
+}
+
+pub(crate) fn above<T: Real>(param: &'static str, v: T, min: T) -> Result<(), ConfigError> {
+    finite(param, v)?;
+    if v > min {
+        Ok(())
+    } else {
+        Err(ConfigError::new(param, v, Rule::BandInverted))
+    }
+}
+
+/// What a parameter violates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum Rule {
+    /// NaN or infinite.
+    NotFinite,
+    /// Must be > 0.
+    NotPositive,
+    /// Must be ≥ 0.
+    Negative,
+    /// A lower bound is not below its upper bound.
+    BandInverted,
+    /// Outside the configured envelope.
+    OutsideEnvelope,
+    /// An angle on the wrong side of the vertical for its stage (Eq. 33).
+    WrongQuadrant,
+    /// ρ × maximum length ≥ m01.
+    TetherHeavierThanSatellite,
+    /// e ≥ 0.75: no equilibrium exists over the whole orbit (Eq. 13).
+    NoEquilibrium,
+}
+
+/// A rejected parameter: its name (the field path in [`Config`]), its value and the rule.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub struct ConfigError {
+    /// Field path, e.g. `gains.k1_per_s`.
+    pub param: &'static str,
+    /// The offending value (widened to f64).
+    pub value: f64,
+    /// The rule it breaks.
+    pub rule: Rule,
+}
+
+impl ConfigError {
+    pub(crate) fn new<T: Real>(param: &'static str, value: T, rule: Rule) -> Self {
+        Self {
+            param,
+            value: value.to_f64(),
+            rule,
+        }
+    }
+}
+
+impl core::fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "invalid parameter {} = {}: {:?}",
+            self.param, self.value, self.rule
+        )
+    }
+}
+

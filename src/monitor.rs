@@ -1,0 +1,178 @@
+//! Sensor monitoring: every sensed value is checked before use (as PX4's `_inputValid()`
+//! does) — finite, inside its physical range, and consistent with what came before (no length
+//! jump the reel cannot make, no angle jump, no stuck angle sensor).
+//!
+//! A rejected sample never reaches the law; the controller takes its documented safe action
+//! (see [`crate::controller`]).
+
+use crate::config::{positive, ConfigError};
+use crate::controller::Input;
+use crate::real::Real;
+
+/// Which sensed value was rejected, and why.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum Sensor {
+    /// No sample arrived for this tick (dropout).
+    Missing,
+    /// The tick count went backwards.
+    Tick,
+    /// Length NaN, infinite, ≤ 0 or beyond the spool (+5 %).
+    Length,
+    /// Length differs from the length predicted from the command by more than allowed.
+    LengthJump,
+    /// α NaN, infinite or |α| > π.
+    Alpha,
+    /// α jumped further than α̇ allows.
+    AlphaJump,
+    /// α repeats exactly while α̇ says the tether is moving.
+    AlphaStuck,
+    /// α̇ NaN, infinite or beyond its plausible range.
+    AlphaRate,
+    /// Orbit rate NaN, infinite or outside (0, max].
+    OrbitRate,
+}
+
+/// Thresholds of the sensor checks and the fault timing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MonitorConfig<T> {
+    /// Ticks without a valid sample (or with a law fault) during which the controller coasts
+    /// before it goes to safe hold.
+    pub coast_ticks: u32,
+    /// Consecutive valid samples needed to leave safe hold.
+    pub recovery_ticks: u32,
+    /// Largest accepted |sensed − predicted| length, m (the prediction integrates the
+    /// command; a reel with lag drifts from it by about lag × rate change per tick).
+    pub length_jump_m: T,
+    /// Largest accepted |α − (α_prev + α̇_prev Δt)| per tick, rad.
+    pub alpha_jump_rad: T,
+    /// Identical α readings in a row, with α̇ implying motion, that make a stuck sensor.
+    pub stuck_ticks: u32,
+    /// Motion (∫|α̇|dt over the identical readings) that a stuck verdict needs, rad.
+    pub stuck_motion_rad: T,
+    /// Largest plausible |α̇|, rad/s.
+    pub max_alpha_rate_radps: T,
+    /// Largest plausible orbit rate, rad/s.
+    pub max_orbit_rate_radps: T,
+}
+
+impl<T: Real> MonitorConfig<T> {
+    /// Defaults for a 1 s control period: coast 30 s, recover after 10 good samples, 20 m
+    /// length jumps (an 11.8 m/s rate step through a 1 s reel lag is about 12 m), 0.1 rad angle
+    /// jumps (the paper's |α̇| stays below 1e-3 rad/s), stuck after 20 identical readings
+    /// spanning 1 mrad of implied motion, |α̇| ≤ 0.06 rad/s (≈ 60 n), n ≤ 0.01 rad/s.
+    pub fn default_for_period() -> Self {
+        Self {
+            coast_ticks: 30,
+            recovery_ticks: 10,
+            length_jump_m: T::from_f64(20.0),
+            alpha_jump_rad: T::from_f64(0.1),
+            stuck_ticks: 20,
+            stuck_motion_rad: T::from_f64(1e-3),
+            max_alpha_rate_radps: T::from_f64(0.06),
+            max_orbit_rate_radps: T::from_f64(0.01),
+        }
+    }
+
+    /// Checks the thresholds.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        positive("monitor.coast_ticks", T::from_u32(self.coast_ticks))?;
+        positive("monitor.recovery_ticks", T::from_u32(self.recovery_ticks))?;
+        positive("monitor.length_jump_m", self.length_jump_m)?;
+        positive("monitor.alpha_jump_rad", self.alpha_jump_rad)?;
+        positive("monitor.stuck_ticks", T::from_u32(self.stuck_ticks))?;
+        positive("monitor.stuck_motion_rad", self.stuck_motion_rad)?;
+        positive("monitor.max_alpha_rate_radps", self.max_alpha_rate_radps)?;
+        positive("monitor.max_orbit_rate_radps", self.max_orbit_rate_radps)
+    }
+}
+
+/// The last accepted sample, for the consistency checks.
+#[derive(Clone, Copy, Debug)]
+struct Accepted<T> {
+    tick: u32,
+    alpha_rad: T,
+    alpha_rate_radps: T,
+}
+
+/// State of the sensor checks.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Monitor<T> {
+    last: Option<Accepted<T>>,
+    /// Bits of the last α reading and how often it repeated.
+    same_alpha_bits: u64,
+    same_count: u32,
+    implied_motion_rad: T,
+}
+
+impl<T: Real> Monitor<T> {
+    pub(crate) fn new() -> Self {
+        Self {
+            last: None,
+            same_alpha_bits: 0,
+            same_count: 0,
+            implied_motion_rad: T::ZERO,
+        }
+    }
+
+    /// Checks one sample. `expected_length_m` is the length the controller predicts for this
+    /// tick (`None` when it has no trustworthy prediction); `max_length_m` is the spool end.
+    pub(crate) fn check(
+        &mut self,
+        cfg: &MonitorConfig<T>,
+        x: &Input<T>,
+        expected_length_m: Option<T>,
+        max_length_m: T,
+        period_s: T,
+    ) -> Result<(), Sensor> {
+        let pi = T::from_f64(core::f64::consts::PI);
+        let spool = max_length_m * T::from_f64(1.05);
+        if !(x.length_m.is_finite() && x.length_m > T::ZERO && x.length_m <= spool) {
+            return Err(Sensor::Length);
+        }
+        if !(x.alpha_rad.is_finite() && x.alpha_rad.abs() <= pi) {
+            return Err(Sensor::Alpha);
+        }
+        if !(x.alpha_rate_radps.is_finite() && x.alpha_rate_radps.abs() <= cfg.max_alpha_rate_radps) {
+            return Err(Sensor::AlphaRate);
+        }
+        if !(x.orbit_rate_radps.is_finite()
+            && x.orbit_rate_radps > T::ZERO
+            && x.orbit_rate_radps <= cfg.max_orbit_rate_radps)
+        {
+            return Err(Sensor::OrbitRate);
+        }
+        if let Some(expected) = expected_length_m {
+            if (x.length_m - expected).abs() > cfg.length_jump_m {
+                return Err(Sensor::LengthJump);
+            }
+        }
+        if let Some(last) = self.last {
+            let ticks = x.tick.saturating_sub(last.tick).max(1);
+            let dt = T::from_u32(ticks) * period_s;
+            let predicted = last.alpha_rad + last.alpha_rate_radps * dt;
+            if (x.alpha_rad - predicted).abs() > cfg.alpha_jump_rad * T::from_u32(ticks) {
+                return Err(Sensor::AlphaJump);
+            }
+        }
+        // Stuck: the same reading again and again while α̇ says it should have moved.
+        let bits = x.alpha_rad.to_f64().to_bits();
+        if self.same_count > 0 && bits == self.same_alpha_bits {
+            self.same_count = self.same_count.saturating_add(1);
+            self.implied_motion_rad = self.implied_motion_rad + x.alpha_rate_radps.abs() * period_s;
+        } else {
+            self.same_alpha_bits = bits;
+            self.same_count = 1;
+            self.implied_motion_rad = T::ZERO;
+        }
+        if self.same_count >= cfg.stuck_ticks && self.implied_motion_rad >= cfg.stuck_motion_rad {
+            return Err(Sensor::AlphaStuck);
+        }
+        self.last = Some(Accepted {
+            tick: x.tick,
+            alpha_rad: x.alpha_rad,
+            alpha_rate_radps: x.alpha_rate_radps,
+        });
+        Ok(())
+    }
+}
