@@ -59,12 +59,27 @@ struct Panel {
     marker_x: Option<f64>,
 }
 
+/// Checks that the figures' text can be rendered: plotters' `ttf` backend needs a sans-serif
+/// system font that fontconfig can find.
+pub fn check_font() -> anyhow::Result<()> {
+    FontDesc::new(FontFamily::from(FONT), 16.0, FontStyle::Normal)
+        .box_size("α (deg)")
+        .map(|_| ())
+        .map_err(|e| {
+            anyhow!(
+                "no {FONT} font for the figures' text ({e}); install one that fontconfig finds, \
+                 e.g. Debian's fonts-dejavu-core"
+            )
+        })
+}
+
 /// Writes the three figures to `dir` as PNG and SVG; returns the paths written.
 pub fn write_figures(
     dir: &Path,
     scenario: &Scenario,
     history: &History,
 ) -> anyhow::Result<Vec<PathBuf>> {
+    check_font()?;
     let figures = figures(scenario, &history.samples);
     let mut written = Vec::new();
     for (stem, panels) in FIGURE_STEMS.iter().zip(&figures) {

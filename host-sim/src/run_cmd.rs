@@ -47,7 +47,7 @@ pub fn is_usage_error(err: &anyhow::Error) -> bool {
 }
 
 /// The files one run writes, and how long its parts took.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct RunOutcome {
     /// The output directory.
     pub dir: PathBuf,
@@ -59,8 +59,10 @@ pub struct RunOutcome {
     pub summary_txt: PathBuf,
     /// `scenario.toml`: the scenario as run (file plus overrides).
     pub scenario_toml: PathBuf,
-    /// The figures, PNG and SVG.
+    /// The figures, PNG and SVG (empty if they could not be drawn).
     pub figures: Vec<PathBuf>,
+    /// Why the figures could not be drawn (the other outputs are written regardless).
+    pub figure_error: Option<anyhow::Error>,
     /// Wall time of the simulation.
     pub sim_time: Duration,
     /// Wall time of writing every output.
@@ -71,11 +73,14 @@ pub struct RunOutcome {
 
 /// `tss-sim run`: with the closed-loop simulation [`crate::sim::run`].
 pub fn run(args: RunArgs) -> anyhow::Result<()> {
-    let outcome = run_with(&args, |scenario, probes, progress| {
+    let mut outcome = run_with(&args, |scenario, probes, progress| {
         crate::sim::run(scenario, probes, progress)
     })?;
     print_outcome(&outcome);
-    Ok(())
+    match outcome.figure_error.take() {
+        Some(e) => Err(e.context("the figures were not drawn (every other output was written)")),
+        None => Ok(()),
+    }
 }
 
 /// Prints the report and where the files are.
@@ -97,9 +102,11 @@ pub fn print_outcome(o: &RunOutcome) {
     ] {
         let _ = writeln!(stdout, "  {}", p.display());
     }
-    let _ = writeln!(stdout, "Figures (Figs. 4–6 of the paper):");
-    for p in &o.figures {
-        let _ = writeln!(stdout, "  {}", p.display());
+    if o.figure_error.is_none() {
+        let _ = writeln!(stdout, "Figures (Figs. 4–6 of the paper):");
+        for p in &o.figures {
+            let _ = writeln!(stdout, "  {}", p.display());
+        }
     }
 }
 
@@ -167,10 +174,9 @@ fn progress_bar(duration_s: f64) -> ProgressBar {
     }
     // Whole seconds of mission time; the bar's unit.
     let bar = ProgressBar::new(duration_s.ceil().max(1.0) as u64);
-    if let Ok(style) = ProgressStyle::with_template(
-        "{spinner} simulating [{bar:40}] {percent:>3}% of {len} s mission time, \
-         {elapsed} elapsed, eta {eta}",
-    ) {
+    if let Ok(style) =
+        ProgressStyle::with_template("{spinner} simulating [{bar:30}] {pos}/{len} s, eta {eta}")
+    {
         bar.set_style(style.progress_chars("=> "));
     }
     bar
@@ -232,7 +238,10 @@ where
     let report = format!("{}\n{}", summary.render(), table.render());
     let summary_txt = dir.join("summary.txt");
     write_file(&summary_txt, |w| w.write_all(report.as_bytes()))?;
-    let figures = plots::write_figures(&dir, &scenario, &history)?;
+    let (figures, figure_error) = match plots::write_figures(&dir, &scenario, &history) {
+        Ok(paths) => (paths, None),
+        Err(e) => (Vec::new(), Some(e)),
+    };
     let write_time = started.elapsed();
 
     Ok(RunOutcome {
@@ -242,6 +251,7 @@ where
         summary_txt,
         scenario_toml,
         figures,
+        figure_error,
         sim_time,
         write_time,
         report,
