@@ -107,7 +107,11 @@ impl<T: Real> Config<T> {
         let e = self.orbit.eccentricity;
         at_least("orbit.eccentricity", e, T::ZERO)?;
         if e >= T::from_f64(0.75) {
-            return Err(ConfigError::new("orbit.eccentricity", e, Rule::NoEquilibrium));
+            return Err(ConfigError::new(
+                "orbit.eccentricity",
+                e,
+                Rule::NoEquilibrium,
+            ));
         }
         positive("masses.main_initial_kg", self.masses.main_initial_kg)?;
         positive("masses.sub_kg", self.masses.sub_kg)?;
@@ -284,4 +288,3 @@ impl core::fmt::Display for ConfigError {
         )
     }
 }
-

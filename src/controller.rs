@@ -176,6 +176,9 @@ pub struct Output<T> {
     pub fault: Option<Fault>,
 }
 
+/// Bound on the reported [`Output::equilibrium_margin`] (x grows as 1/l toward docking).
+pub const MAX_REPORTED_MARGIN: f64 = 1e6;
+
 /// The reel controller (see the module docs for a complete example).
 #[derive(Clone, Debug)]
 pub struct Controller<T> {
@@ -215,7 +218,11 @@ impl<T: Real> Controller<T> {
     pub fn new(cfg: Config<T>) -> Result<Self, ConfigError> {
         cfg.validate()?;
         let existence = ExistenceMonitor::from_orbit(&cfg.orbit).map_err(|_| {
-            ConfigError::new("orbit.eccentricity", cfg.orbit.eccentricity, Rule::NoEquilibrium)
+            ConfigError::new(
+                "orbit.eccentricity",
+                cfg.orbit.eccentricity,
+                Rule::NoEquilibrium,
+            )
         })?;
         Ok(Self {
             existence,
@@ -279,8 +286,13 @@ impl<T: Real> Controller<T> {
         let first = self.last_tick.is_none();
         self.last_tick = Some(tick);
         let elapsed_s = T::from_u32(elapsed_ticks.max(1)) * dt;
-        // Dead reckoning: the reel ran at the last command since the last step.
-        self.length_estimate_m = self.length_estimate_m + self.last_rate_cmd_mps * T::from_u32(elapsed_ticks) * dt;
+        // Dead reckoning: the reel ran at the last command since the last step (within the
+        // physical range: the reel cannot pay out past its spool nor wind in past zero).
+        let spool =
+            self.cfg.envelope.max_length_m * T::from_f64(1.0 + crate::monitor::SPOOL_MARGIN);
+        self.length_estimate_m = (self.length_estimate_m
+            + self.last_rate_cmd_mps * T::from_u32(elapsed_ticks) * dt)
+            .clamp_to(T::ZERO, spool);
 
         // Sequencer: stage 1 starts with the first step; stage 2 at its tick or on command.
         // Each stage restarts the blend from the current rate (SPEC §7).
@@ -305,7 +317,10 @@ impl<T: Real> Controller<T> {
             _ => Some(self.length_estimate_m),
         };
         let env = self.cfg.envelope;
-        if let Err(s) = self.monitor.check(&self.cfg.monitor, x, expected, env.max_length_m, dt) {
+        if let Err(s) = self
+            .monitor
+            .check(&self.cfg.monitor, x, expected, env.max_length_m, dt)
+        {
             return self.reject(tick, Fault::Sensor(s), None, flags);
         }
         self.length_estimate_m = x.length_m;
@@ -442,13 +457,20 @@ impl<T: Real> Controller<T> {
 
     /// No usable sample or no law solution at this tick: coast (Degraded) for up to
     /// `coast_ticks`, then safe hold.
-    fn reject(&mut self, tick: u32, fault: Fault, reference: Option<&Reference<T>>, mut flags: Flags) -> Output<T> {
+    fn reject(
+        &mut self,
+        tick: u32,
+        fault: Fault,
+        reference: Option<&Reference<T>>,
+        mut flags: Flags,
+    ) -> Output<T> {
         self.bad_ticks = self.bad_ticks.saturating_add(1);
-        let next = if self.health == Health::SafeHold || self.bad_ticks > self.cfg.monitor.coast_ticks {
-            Health::SafeHold
-        } else {
-            Health::Degraded
-        };
+        let next =
+            if self.health == Health::SafeHold || self.bad_ticks > self.cfg.monitor.coast_ticks {
+                Health::SafeHold
+            } else {
+                Health::Degraded
+            };
         self.set_health(next, &mut flags);
         self.good_ticks = 0;
         let fallback = Reference {
@@ -466,12 +488,25 @@ impl<T: Real> Controller<T> {
     /// The safe actions. Degraded: keep the last command (coast). Safe hold: ramp the rate to
     /// zero at the acceleration limit. Both stay inside the length limits, judged on the
     /// predicted length.
-    fn hold(&mut self, tick: u32, reference: &Reference<T>, mut flags: Flags, fault: Option<Fault>) -> Output<T> {
+    fn hold(
+        &mut self,
+        tick: u32,
+        reference: &Reference<T>,
+        mut flags: Flags,
+        fault: Option<Fault>,
+    ) -> Output<T> {
         flags.set(Flags::SAFE_ACTION);
         let dt = self.cfg.period_s;
         let prev = self.last_rate_cmd_mps;
-        let target = if self.health == Health::Degraded { prev } else { T::ZERO };
-        let (rate, sat) = self.cfg.envelope.limit(target, prev, self.length_estimate_m, dt);
+        let target = if self.health == Health::Degraded {
+            prev
+        } else {
+            T::ZERO
+        };
+        let (rate, sat) = self
+            .cfg
+            .envelope
+            .limit(target, prev, self.length_estimate_m, dt);
         flags.set_if(sat.length, Flags::LENGTH_LIMITED);
         self.last_rate_cmd_mps = rate;
         let margin = self.equilibrium_margin(self.length_estimate_m, rate, &mut flags);
@@ -497,10 +532,15 @@ impl<T: Real> Controller<T> {
     /// The Eq. 13 margin of the command (whole orbit), flagging a command outside the region.
     fn equilibrium_margin(&self, length_m: T, rate_mps: T, flags: &mut Flags) -> T {
         let mu3 = self.cfg.masses.coefficients(length_m).mu3;
-        match self.existence.check_rate(Anomaly::WholeOrbit, mu3, length_m, rate_mps) {
+        match self
+            .existence
+            .check_rate(Anomaly::WholeOrbit, mu3, length_m, rate_mps)
+        {
             Ok(c) => {
                 flags.set_if(!c.exists, Flags::NO_EQUILIBRIUM);
-                c.margin
+                // x grows as 1/l: near docking the margin can exceed f32; report it bounded.
+                let bound = T::from_f64(MAX_REPORTED_MARGIN);
+                c.margin.clamp_to(-bound, bound)
             }
             // Only a non-positive or non-finite length estimate gets here (a long coast
             // toward docking): no equilibrium statement can be made.
@@ -514,9 +554,13 @@ impl<T: Real> Controller<T> {
     fn update_phase(&mut self, length_m: T, slewing: bool) {
         let capture = self.cfg.keep_capture_m;
         self.phase = match self.phase {
-            Phase::Deploy if length_m >= self.cfg.stage1.schedule.high_length_m - capture => Phase::Keep1,
+            Phase::Deploy if length_m >= self.cfg.stage1.schedule.high_length_m - capture => {
+                Phase::Keep1
+            }
             Phase::Slew if !slewing => Phase::Retrieve,
-            Phase::Retrieve if length_m <= self.cfg.stage2.schedule.low_length_m + capture => Phase::Keep2,
+            Phase::Retrieve if length_m <= self.cfg.stage2.schedule.low_length_m + capture => {
+                Phase::Keep2
+            }
             p => p,
         };
     }

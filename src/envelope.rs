@@ -39,10 +39,20 @@ impl<T: Real> Envelope<T> {
     ///
     /// The result is finite and within ±`max_rate_mps` whenever `previous_mps` is (a NaN
     /// request is treated as a request to keep the previous command).
-    pub fn limit(&self, requested_mps: T, previous_mps: T, length_m: T, dt_s: T) -> (T, Saturation) {
+    pub fn limit(
+        &self,
+        requested_mps: T,
+        previous_mps: T,
+        length_m: T,
+        dt_s: T,
+    ) -> (T, Saturation) {
         let mut sat = Saturation::default();
         let vmax = self.max_rate_mps;
-        let mut y = if requested_mps.is_nan() { previous_mps } else { requested_mps };
+        let mut y = if requested_mps.is_nan() {
+            previous_mps
+        } else {
+            requested_mps
+        };
         if y.abs() > vmax {
             sat.rate = true;
             y = y.clamp_to(-vmax, vmax);
@@ -108,7 +118,10 @@ mod tests {
     #[test]
     fn docking_limit_holds() {
         let (y, s) = env().limit(-1.0, -0.1, 0.6, 1.0);
-        assert!(s.length && y >= -0.1 - 1e-12 && 0.6 + y >= 0.5 - 1e-12, "{y}");
+        assert!(
+            s.length && y >= -0.1 - 1e-12 && 0.6 + y >= 0.5 - 1e-12,
+            "{y}"
+        );
     }
 
     #[test]

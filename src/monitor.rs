@@ -17,7 +17,7 @@ pub enum Sensor {
     Missing,
     /// The tick count went backwards.
     Tick,
-    /// Length NaN, infinite, ≤ 0 or beyond the spool (+5 %).
+    /// Length NaN, infinite, below [`MIN_PLAUSIBLE_LENGTH_M`] or beyond the spool (+5 %).
     Length,
     /// Length differs from the length predicted from the command by more than allowed.
     LengthJump,
@@ -29,9 +29,16 @@ pub enum Sensor {
     AlphaStuck,
     /// α̇ NaN, infinite or beyond its plausible range.
     AlphaRate,
-    /// Orbit rate NaN, infinite or outside (0, max].
+    /// Orbit rate NaN, infinite or outside [min, max].
     OrbitRate,
 }
+
+/// Shortest length a length sensor can plausibly report, m (1 mm): anything shorter is a
+/// sensor fault, not a tether.
+pub const MIN_PLAUSIBLE_LENGTH_M: f64 = 1e-3;
+
+/// A sensed length beyond the spool end by more than this fraction is a sensor fault.
+pub const SPOOL_MARGIN: f64 = 0.05;
 
 /// Thresholds of the sensor checks and the fault timing.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -52,6 +59,8 @@ pub struct MonitorConfig<T> {
     pub stuck_motion_rad: T,
     /// Largest plausible |α̇|, rad/s.
     pub max_alpha_rate_radps: T,
+    /// Smallest plausible orbit rate, rad/s.
+    pub min_orbit_rate_radps: T,
     /// Largest plausible orbit rate, rad/s.
     pub max_orbit_rate_radps: T,
 }
@@ -60,7 +69,8 @@ impl<T: Real> MonitorConfig<T> {
     /// Defaults for a 1 s control period: coast 30 s, recover after 10 good samples, 20 m
     /// length jumps (an 11.8 m/s rate step through a 1 s reel lag is about 12 m), 0.1 rad angle
     /// jumps (the paper's |α̇| stays below 1e-3 rad/s), stuck after 20 identical readings
-    /// spanning 1 mrad of implied motion, |α̇| ≤ 0.06 rad/s (≈ 60 n), n ≤ 0.01 rad/s.
+    /// spanning 1 mrad of implied motion, |α̇| ≤ 0.06 rad/s (≈ 60 n), 1e-5 ≤ n ≤ 0.01 rad/s
+    /// (orbit periods from 10 minutes to a week; LEO is ≈ 1.1e-3).
     pub fn default_for_period() -> Self {
         Self {
             coast_ticks: 30,
@@ -70,6 +80,7 @@ impl<T: Real> MonitorConfig<T> {
             stuck_ticks: 20,
             stuck_motion_rad: T::from_f64(1e-3),
             max_alpha_rate_radps: T::from_f64(0.06),
+            min_orbit_rate_radps: T::from_f64(1e-5),
             max_orbit_rate_radps: T::from_f64(0.01),
         }
     }
@@ -83,7 +94,12 @@ impl<T: Real> MonitorConfig<T> {
         positive("monitor.stuck_ticks", T::from_u32(self.stuck_ticks))?;
         positive("monitor.stuck_motion_rad", self.stuck_motion_rad)?;
         positive("monitor.max_alpha_rate_radps", self.max_alpha_rate_radps)?;
-        positive("monitor.max_orbit_rate_radps", self.max_orbit_rate_radps)
+        positive("monitor.min_orbit_rate_radps", self.min_orbit_rate_radps)?;
+        crate::config::above(
+            "monitor.max_orbit_rate_radps",
+            self.max_orbit_rate_radps,
+            self.min_orbit_rate_radps,
+        )
     }
 }
 
@@ -126,18 +142,20 @@ impl<T: Real> Monitor<T> {
         period_s: T,
     ) -> Result<(), Sensor> {
         let pi = T::from_f64(core::f64::consts::PI);
-        let spool = max_length_m * T::from_f64(1.05);
-        if !(x.length_m.is_finite() && x.length_m > T::ZERO && x.length_m <= spool) {
+        let spool = max_length_m * T::from_f64(1.0 + SPOOL_MARGIN);
+        let shortest = T::from_f64(MIN_PLAUSIBLE_LENGTH_M);
+        if !(x.length_m.is_finite() && x.length_m >= shortest && x.length_m <= spool) {
             return Err(Sensor::Length);
         }
         if !(x.alpha_rad.is_finite() && x.alpha_rad.abs() <= pi) {
             return Err(Sensor::Alpha);
         }
-        if !(x.alpha_rate_radps.is_finite() && x.alpha_rate_radps.abs() <= cfg.max_alpha_rate_radps) {
+        if !(x.alpha_rate_radps.is_finite() && x.alpha_rate_radps.abs() <= cfg.max_alpha_rate_radps)
+        {
             return Err(Sensor::AlphaRate);
         }
         if !(x.orbit_rate_radps.is_finite()
-            && x.orbit_rate_radps > T::ZERO
+            && x.orbit_rate_radps >= cfg.min_orbit_rate_radps
             && x.orbit_rate_radps <= cfg.max_orbit_rate_radps)
         {
             return Err(Sensor::OrbitRate);

@@ -1,0 +1,166 @@
+//! Proof that bad input never becomes a bad command (issue 5): property tests over the whole
+//! input space of the step function.
+//!
+//! Every field of every sample is drawn from all 2³² f32 bit patterns (NaN with any payload,
+//! ±inf, subnormals, ±0, huge values) or from a plausible physical range, in random sequences
+//! with random tick gaps and dropouts. Whatever arrives, each output must be finite and inside
+//! the envelope.
+
+use proptest::prelude::*;
+use tss_reel::controller::{Config, Controller, Envelope, Flags, Input, Output};
+
+/// A realistic reel: 10 m/s, 0.1 m/s², 0.5 m to 40 km (tighter than the paper's defaults, so
+/// the limits are exercised).
+fn config() -> Config<f32> {
+    Config {
+        envelope: Envelope {
+            max_rate_mps: 10.0,
+            max_accel_mps2: 0.1,
+            min_length_m: 0.5,
+            max_length_m: 40_000.0,
+        },
+        ..Config::paper()
+    }
+}
+
+/// Any f32 at all, by bit pattern.
+fn any_bits() -> impl Strategy<Value = f32> {
+    any::<u32>().prop_map(f32::from_bits)
+}
+
+/// Half the time any bit pattern, half the time a value in a plausible range.
+fn field(lo: f32, hi: f32) -> impl Strategy<Value = f32> {
+    prop_oneof![any_bits(), lo..hi]
+}
+
+#[derive(Clone, Debug)]
+enum Event {
+    Sample {
+        gap: u32,
+        length_m: f32,
+        alpha_rad: f32,
+        alpha_rate_radps: f32,
+        orbit_rate_radps: f32,
+    },
+    Missing {
+        gap: u32,
+    },
+    /// A tick from the past.
+    Backwards {
+        by: u32,
+    },
+}
+
+fn event() -> impl Strategy<Value = Event> {
+    let gap = prop_oneof![Just(1u32), 0u32..5, any::<u32>()];
+    prop_oneof![
+        8 => (gap.clone(), field(0.0, 45_000.0), field(-3.2, 3.2), field(-0.07, 0.07), field(0.0, 0.012))
+            .prop_map(|(gap, length_m, alpha_rad, alpha_rate_radps, orbit_rate_radps)| Event::Sample {
+                gap, length_m, alpha_rad, alpha_rate_radps, orbit_rate_radps
+            }),
+        1 => gap.prop_map(|gap| Event::Missing { gap }),
+        1 => (1u32..100).prop_map(|by| Event::Backwards { by }),
+    ]
+}
+
+fn assert_output_sane(out: &Output<f32>, prev_rate: f32, elapsed_ticks: u32, env: &Envelope<f32>) {
+    let fields = [
+        out.rate_cmd_mps,
+        out.accel_cmd_mps2,
+        out.law_rate_mps,
+        out.blend_weight,
+        out.alpha_ref_rad,
+        out.alpha_ref_rate_radps,
+        out.delta_rad,
+        out.delta_rate_radps,
+        out.length_estimate_m,
+        out.equilibrium_margin,
+    ];
+    // law_rate_mps may legitimately be any finite value; all must be finite.
+    assert!(
+        fields.iter().all(|v| v.is_finite()),
+        "non-finite output {out:?}"
+    );
+    assert!(
+        out.rate_cmd_mps.abs() <= env.max_rate_mps,
+        "rate outside envelope: {out:?}"
+    );
+    assert!((0.0..=1.0).contains(&out.blend_weight));
+    if !out.flags.contains(Flags::LENGTH_LIMITED) {
+        let dv = env.max_accel_mps2 * elapsed_ticks.max(1) as f32 * 1.0;
+        assert!(
+            (out.rate_cmd_mps - prev_rate).abs() <= dv * (1.0 + 1e-5) + 1e-6,
+            "acceleration limit broken: {prev_rate} -> {out:?}"
+        );
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 100_000, ..ProptestConfig::default() })]
+
+    /// Any sequence of any inputs: every output finite, the rate within ±max, the change per
+    /// tick within the acceleration limit unless a hard length limit had to act.
+    #[test]
+    fn command_always_finite_and_in_envelope(start in any::<u32>(), events in prop::collection::vec(event(), 1..8)) {
+        let cfg = config();
+        let env = cfg.envelope;
+        let mut ctl = Controller::new(cfg).unwrap();
+        let mut tick = start;
+        let mut last_tick: Option<u32> = None;
+        let mut prev_rate = cfg.initial_rate_mps;
+        for ev in events {
+            let out = match ev {
+                Event::Sample { gap, length_m, alpha_rad, alpha_rate_radps, orbit_rate_radps } => {
+                    tick = tick.saturating_add(gap);
+                    ctl.step(&Input { tick, length_m, alpha_rad, alpha_rate_radps, orbit_rate_radps })
+                }
+                Event::Missing { gap } => {
+                    tick = tick.saturating_add(gap);
+                    ctl.step_missing(tick)
+                }
+                Event::Backwards { by } => ctl.step_missing(tick.saturating_sub(by)),
+            };
+            let elapsed = match last_tick {
+                Some(t) if out.tick >= t => out.tick - t,
+                _ => 1,
+            };
+            assert_output_sane(&out, prev_rate, elapsed, &env);
+            if last_tick.is_none_or(|t| out.tick >= t) {
+                last_tick = Some(out.tick);
+            }
+            prev_rate = out.rate_cmd_mps;
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2_000, ..ProptestConfig::default() })]
+
+    /// Plausible random walks of α and α̇ with the length following the command exactly: the
+    /// tether never leaves [l_min, l_max], whatever the law asks.
+    #[test]
+    fn tether_stays_inside_length_limits(
+        l0 in 0.6f32..39_999.0,
+        alpha0 in -1.5f32..1.5,
+        steps in prop::collection::vec((-0.02f32..0.02, -1e-3f32..1e-3), 50..400),
+    ) {
+        let cfg = config();
+        let env = cfg.envelope;
+        let mut ctl = Controller::new(cfg).unwrap();
+        let mut l = f64::from(l0);
+        let mut alpha = alpha0;
+        for (tick, (dalpha, rate)) in steps.into_iter().enumerate() {
+            alpha = (alpha + dalpha).clamp(-1.5, 1.5);
+            let out = ctl.step(&Input {
+                tick: tick as u32,
+                length_m: l as f32,
+                alpha_rad: alpha,
+                alpha_rate_radps: rate,
+                orbit_rate_radps: 1.06e-3,
+            });
+            l += f64::from(out.rate_cmd_mps);
+            prop_assert!(l >= f64::from(env.min_length_m) - 1e-3 && l <= f64::from(env.max_length_m) + 1e-2,
+                "l = {l} after {out:?}");
+        }
+    }
+}
