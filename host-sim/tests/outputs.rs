@@ -225,3 +225,30 @@ fn a_failed_simulation_writes_nothing() {
     assert!(!out.exists());
     assert!(!tss_sim::run_cmd::is_usage_error(&e));
 }
+
+#[test]
+fn without_a_font_the_other_outputs_are_written_and_the_error_names_the_package() {
+    let tmp = tempfile::tempdir().unwrap();
+    // A fontconfig configuration with no font directories: no font can be found.
+    let conf = tmp.path().join("fonts.conf");
+    std::fs::write(&conf, "<?xml version=\"1.0\"?><fontconfig></fontconfig>").unwrap();
+    let out = tmp.path().join("nofont");
+    let o = Command::new(BIN)
+        .args([
+            "run",
+            paper().to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .args(["--set", "simulation.duration_s=60"])
+        .env("FONTCONFIG_FILE", &conf)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("fonts-dejavu-core"), "{stderr}");
+    for f in ["history.csv", "table1.csv", "summary.txt", "scenario.toml"] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    assert!(!out.join("fig4_length_tension.png").exists());
+}
