@@ -12,6 +12,7 @@ pub mod config;
 pub mod controller;
 pub mod envelope;
 pub mod equilibrium;
+pub mod fastmath;
 pub mod law;
 pub mod mass;
 pub mod monitor;

@@ -9,8 +9,9 @@ use core::ops::{Add, Div, Mul, Neg, Sub};
 
 /// A real scalar (`f32` or `f64`) with the handful of functions the paper's equations need.
 ///
-/// Transcendental functions come from `libm`, so results are identical on the host and on the
-/// target (no dependence on the platform's C library).
+/// Transcendental functions come from `libm` (and, for f32 sine and cosine, from
+/// [`crate::fastmath`], which stays in single precision), so results are identical on the host
+/// and on the target (no dependence on the platform's C library).
 pub trait Real:
     Copy
     + Debug
@@ -105,11 +106,11 @@ impl Real for f32 {
     }
     #[inline]
     fn sin(self) -> Self {
-        libm::sinf(self)
+        crate::fastmath::sin(self)
     }
     #[inline]
     fn cos(self) -> Self {
-        libm::cosf(self)
+        crate::fastmath::cos(self)
     }
     #[inline]
     fn exp(self) -> Self {
