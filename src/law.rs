@@ -106,6 +106,10 @@ pub struct LawOutput<T> {
     pub ref_rate_radps: T,
     /// n + δ̇, the Eq. 27 denominator, rad/s.
     pub denominator_radps: T,
+    /// sin 2α (= sin(2δ + 2α_r)), reused by [`acceleration`].
+    pub sin_two_alpha: T,
+    /// cos 2α, reused by [`acceleration`].
+    pub cos_two_alpha: T,
 }
 
 /// Smallest admissible value of b relative to n: below this the Eq. 27 denominator n + δ̇ is
@@ -127,7 +131,8 @@ pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
     let l_prime = x.length_m / (two + x.mu3);
     let delta = x.alpha_rad - x.ref_angle_rad;
     // sin(2δ + 2α_r) = sin 2α.
-    let gravity = three_halves * n * n * (two * x.alpha_rad).sin();
+    let (sin2a, cos2a) = (two * x.alpha_rad).sin_cos();
+    let gravity = three_halves * n * n * sin2a;
     let w = n + x.alpha_rate_radps - x.ref_time_rate_radps;
     let g0 =
         k1 * (x.alpha_rate_radps - x.ref_time_rate_radps) + x.gains.k2_per_s2 * delta - gravity;
@@ -162,6 +167,8 @@ pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
         delta_rate_radps: delta_rate,
         ref_rate_radps: ref_rate,
         denominator_radps: denom,
+        sin_two_alpha: sin2a,
+        cos_two_alpha: cos2a,
     })
 }
 
@@ -185,14 +192,14 @@ pub fn acceleration<T: Real>(x: &LawInput<T>, s: &LawOutput<T>) -> Result<T, Law
     let d = s.denominator_radps;
     let mu3_dot = x.mu3_per_m * y;
     // Eq. 5b (circular, β = 0) with l̇ = y.
-    let alpha_accel = -(n + x.alpha_rate_radps) * two_mu3 * y / l
-        - T::from_f64(1.5) * n * n * (two * x.alpha_rad).sin();
+    let alpha_accel =
+        -(n + x.alpha_rate_radps) * two_mu3 * y / l - T::from_f64(1.5) * n * n * s.sin_two_alpha;
     // u̇ = (L′/D)[(k1 − N/D) δ̈ + k2 δ̇ − 3n² α̇ cos2α] + u (y/l − μ̇3/(2+μ3)),  N/D = u/L′.
     let k_eff = x.gains.k1_per_s - u / l_prime;
     let b_coef = (T::ONE - e) * l_prime / d * k_eff;
     let rest = l_prime / d
         * (x.gains.k2_per_s2 * s.delta_rate_radps
-            - three * n * n * x.alpha_rate_radps * (two * x.alpha_rad).cos())
+            - three * n * n * x.alpha_rate_radps * s.cos_two_alpha)
         + u * (y / l - mu3_dot / two_mu3);
     let a = x.decay_rate_per_s * e * (u - x.initial_rate_mps)
         + (T::ONE - e) * rest

@@ -40,6 +40,11 @@ pub trait Real:
     fn exp(self) -> Self;
     /// Square root (NaN for negative input).
     fn sqrt(self) -> Self;
+    /// `(sin x, cos x)`, sharing the argument reduction where the implementation can.
+    #[inline]
+    fn sin_cos(self) -> (Self, Self) {
+        (self.sin(), self.cos())
+    }
     /// Absolute value.
     fn abs(self) -> Self;
     /// Four-quadrant arctangent of `self / x`.
@@ -111,6 +116,10 @@ impl Real for f32 {
     #[inline]
     fn cos(self) -> Self {
         crate::fastmath::cos(self)
+    }
+    #[inline]
+    fn sin_cos(self) -> (Self, Self) {
+        crate::fastmath::sin_cos(self)
     }
     #[inline]
     fn exp(self) -> Self {
