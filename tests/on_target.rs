@@ -1,2 +1,123 @@
-//! On-target tests (placeholder until the platform lands).
+//! On-target tests: the library's arithmetic run on the Cortex-M4F itself (in f32, with the
+//! FPU and libm as flown), in QEMU, by the defmt-test harness.
+//!
+//! Run with `cargo tt` (`cargo test --target thumbv7em-none-eabihf --test on_target`); the runner
+//! `scripts/qemu-run` boots the test ELF and decodes its log. Each `#[test]` is one function in the
+//! `tests` module below; a failed `defmt::assert!` panics, panic-probe turns that into a
+//! HardFault, and the HardFault handler (the firmware's own, `src/firmware/exit.rs`) exits QEMU
+//! with a failure, so a failing test fails the run at once.
+//!
+//! To add a test: add a `#[test] fn name() { … }` to `mod tests`, using `tss_reel`'s public API
+//! and `defmt::assert!`. Tolerances are for f32 arithmetic.
+//!
+//! On the host this file compiles to an empty program (the harness is `false` in Cargo.toml), so
+//! `cargo test --workspace` builds and runs it as a no-op; the host's own tests of the same
+//! functions (in f64) are the library's unit tests.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+#![deny(unsafe_code)]
+
+/// Host stub: the tests in this file run only on the target (see the crate docs).
+#[cfg(not(target_os = "none"))]
 fn main() {}
+
+// The global logger and the panic handler, as in the firmware.
+#[cfg(target_os = "none")]
+use defmt_semihosting as _;
+#[cfg(target_os = "none")]
+use panic_probe as _;
+
+/// The firmware's exits and fault handlers (HardFault => failing exit), shared file.
+#[cfg(target_os = "none")]
+#[allow(dead_code)] // `success` is the firmware's; defmt-test has its own success exit.
+#[path = "../src/firmware/exit.rs"]
+mod exit;
+
+/// Constants and helpers of the tests (defmt-test allows only test functions in `mod tests`).
+#[cfg(target_os = "none")]
+mod support {
+    use tss_reel::mass::MassModel;
+
+    /// The paper's orbit radius, m (Section 6: R = 7078 km).
+    pub const R_PAPER_M: f32 = 7_078_000.0;
+
+    /// |a − b| ≤ rel·|b|.
+    pub fn close_rel(a: f32, b: f32, rel: f32) -> bool {
+        (a - b).abs() <= rel * b.abs()
+    }
+
+    /// A thin tether, ρ = 1e-3 kg/m, on the paper's satellites.
+    pub fn thin_tether() -> MassModel<f32> {
+        MassModel {
+            tether_density_kg_per_m: 1e-3,
+            ..MassModel::paper()
+        }
+    }
+}
+
+#[cfg(target_os = "none")]
+#[defmt_test::tests]
+mod tests {
+    use super::support::{close_rel, thin_tether, R_PAPER_M};
+    use tss_reel::mass::MassModel;
+    use tss_reel::orbit::circular_rate_radps;
+
+    #[test]
+    fn orbit_rate_of_paper_orbit_in_f32() {
+        // n = √(μ/R³) = 1.060 237 e-3 rad/s; f32 resolves ~1e-10 here.
+        let n = circular_rate_radps::<f32>(R_PAPER_M);
+        defmt::assert!((n - 1.060_237_2e-3).abs() < 1e-9, "n = {=f32} rad/s", n);
+    }
+
+    #[test]
+    fn massless_tether_coefficients_at_30_km() {
+        let c = MassModel::<f32>::paper().coefficients(30_000.0);
+        defmt::assert_eq!(c.mu1, 0.0);
+        defmt::assert_eq!(c.mu2, 1.0);
+        defmt::assert_eq!(c.mu3, 0.0);
+        defmt::assert_eq!(c.tether_kg, 0.0);
+        // M* = m1 m2 / M = 1e6 / 10100 kg.
+        defmt::assert!(
+            close_rel(c.reduced_kg, 99.009_9, 1e-6),
+            "M* = {=f32}",
+            c.reduced_kg
+        );
+    }
+
+    #[test]
+    fn thin_tether_coefficients_at_30_km() {
+        // Hand values (f64) from the library's unit test `thin_tether_at_30_km_matches_hand_values`.
+        let c = thin_tether().coefficients(30_000.0);
+        defmt::assert!(close_rel(c.mu3, 0.088_861_56, 1e-5), "mu3 = {=f32}", c.mu3);
+        defmt::assert!(close_rel(c.mu1, 0.113_880_1, 1e-5), "mu1 = {=f32}", c.mu1);
+        defmt::assert!(close_rel(c.mu2, 0.884_615_4, 1e-6), "mu2 = {=f32}", c.mu2);
+        defmt::assert!(
+            close_rel(c.reduced_kg, 108.690_59, 1e-6),
+            "M* = {=f32}",
+            c.reduced_kg
+        );
+        defmt::assert!(
+            close_rel(c.total_kg, 10_100.0, 1e-7),
+            "M = {=f32}",
+            c.total_kg
+        );
+    }
+
+    #[test]
+    fn thin_tether_mu3_grows_with_length() {
+        // μ3 = l (dM*/dl) / M* > 0 and increasing over the mission's range, 2 km to 30 km.
+        let model = thin_tether();
+        let mut previous = 0.0_f32;
+        let mut length_m = 2_000.0_f32;
+        while length_m <= 30_000.0 {
+            let mu3 = model.coefficients(length_m).mu3;
+            defmt::assert!(
+                mu3.is_finite() && mu3 > previous,
+                "mu3({=f32} m) = {=f32}",
+                length_m,
+                mu3
+            );
+            previous = mu3;
+            length_m += 1_000.0;
+        }
+    }
+}

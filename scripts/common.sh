@@ -1,0 +1,51 @@
+# shellcheck shell=bash
+# Shared helpers of the project's scripts. Source it: `source "$(dirname "$0")/common.sh"`.
+# It moves to the repository root, so every script works from any working directory.
+
+REPO_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$REPO_ROOT" || exit 1
+
+# Tools installed by `cargo install` land in $CARGO_HOME/bin; make sure this shell finds them.
+CARGO_BIN_DIR=${CARGO_HOME:-$HOME/.cargo}/bin
+case ":$PATH:" in
+  *":$CARGO_BIN_DIR:"*) ;;
+  *) export PATH="$CARGO_BIN_DIR:$PATH" ;;
+esac
+
+# The firmware's target, its flight build and where that build lands.
+FW_TARGET=thumbv7em-none-eabihf
+FW_PROFILE=firmware
+# shellcheck disable=SC2034 # used by the scripts that source this file
+FW_ELF=target/$FW_TARGET/$FW_PROFILE/tss-reel
+
+# The compile-time defmt filter the expected log is made with (see .cargo/config.toml).
+export DEFMT_LOG=info
+
+# step NAME COMMAND...: run one step, print a banner before and its duration after.
+step() {
+  local name=$1
+  shift
+  local start=$SECONDS
+  printf '\n==> %s\n' "$name"
+  "$@"
+  printf '==> %s: ok (%ss)\n' "$name" "$((SECONDS - start))"
+}
+
+# A tool from the toolchain's llvm-tools component (llvm-size, llvm-nm), which is not on PATH.
+llvm_tool() {
+  local name=$1 sysroot found
+  sysroot=$(rustc --print sysroot)
+  for found in "$sysroot"/lib/rustlib/*/bin/"$name"; do
+    if [[ -x $found ]]; then
+      printf '%s\n' "$found"
+      return 0
+    fi
+  done
+  echo "error: $name not found in $sysroot/lib/rustlib/*/bin (is the llvm-tools component installed? run scripts/setup)" >&2
+  return 1
+}
+
+# Builds the flight firmware (profile `firmware`).
+build_firmware() {
+  cargo build --profile "$FW_PROFILE" --target "$FW_TARGET" --bin tss-reel
+}
