@@ -473,16 +473,10 @@ impl<T: Real> Controller<T> {
             };
         self.set_health(next, &mut flags);
         self.good_ticks = 0;
-        let fallback = Reference {
-            angle: crate::schedule::RefAngle {
-                angle_rad: T::ZERO,
-                slope_rad_per_m: T::ZERO,
-                curvature_rad_per_m2: T::ZERO,
-            },
-            time_rate_radps: T::ZERO,
-            slewing: false,
-        };
-        self.hold(tick, reference.unwrap_or(&fallback), flags, Some(fault))
+        // Without a usable sample, α_r is reported at the predicted length.
+        let tau_s = T::from_u32(tick.saturating_sub(self.stage_start_tick)) * self.cfg.period_s;
+        let predicted = self.reference(tau_s, self.length_estimate_m);
+        self.hold(tick, reference.unwrap_or(&predicted), flags, Some(fault))
     }
 
     /// The safe actions. Degraded: keep the last command (coast). Safe hold: ramp the rate to

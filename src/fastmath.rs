@@ -19,21 +19,21 @@ pub const FAST_RANGE: f32 = 8192.0;
 
 const TWO_OVER_PI: f32 = core::f32::consts::FRAC_2_PI;
 // π/2 = P1 + P2 + P3 (P1: 8 significant bits, P2: 12, P3: the rest).
-const P1: f32 = 1.570_312_5;
-const P2: f32 = 4.837_512_969_970_703e-4;
-const P3: f32 = 7.549_789_954_891_882e-8;
+const P1: f32 = 1.5703125;
+const P2: f32 = 0.0004837513;
+const P3: f32 = 7.54979e-08;
 // Cephes sinf/cosf minimax coefficients on [−π/4, π/4].
-const S1: f32 = -1.666_665_461_1e-1;
-const S2: f32 = 8.332_160_873_6e-3;
-const S3: f32 = -1.951_529_589_1e-4;
-const C1: f32 = 4.166_664_568_298_827e-2;
-const C2: f32 = -1.388_731_625_493_765e-3;
-const C3: f32 = 2.443_315_711_809_948e-5;
+const S1: f32 = -0.16666655;
+const S2: f32 = 0.008332161;
+const S3: f32 = -0.00019515296;
+const C1: f32 = 0.041666646;
+const C2: f32 = -0.0013887316;
+const C3: f32 = 2.4433157e-05;
 
 /// `(sin x, cos x)` in single precision (see the module docs for the accuracy).
 #[inline]
 pub fn sin_cos(x: f32) -> (f32, f32) {
-    if !(libm::fabsf(x) <= FAST_RANGE) {
+    if x.is_nan() || libm::fabsf(x) > FAST_RANGE {
         // NaN, ±inf and huge arguments: libm's answer (NaN for NaN/inf).
         return (libm::sinf(x), libm::cosf(x));
     }

@@ -13,6 +13,7 @@ pub mod controller;
 pub mod envelope;
 pub mod equilibrium;
 pub mod fastmath;
+pub mod hal;
 pub mod law;
 pub mod mass;
 pub mod monitor;

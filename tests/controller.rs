@@ -199,7 +199,7 @@ fn stuck_angle_sensor_is_detected() {
     }
     let (t, f) = verdict.expect("stuck sensor detected");
     assert_eq!(f, Fault::Sensor(Sensor::AlphaStuck));
-    assert!(t >= 10 && t < 40, "after {t} ticks");
+    assert!((10..40).contains(&t), "after {t} ticks");
 }
 
 #[test]

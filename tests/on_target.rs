@@ -120,4 +120,91 @@ mod tests {
             length_m += 1_000.0;
         }
     }
+    #[test]
+    fn fast_sin_cos_matches_f64_on_the_fpu() {
+        // The single-precision sin/cos the law uses, against libm's f64 on the target itself.
+        let mut x = -6.5_f32;
+        while x <= 6.5 {
+            let (s, c) = tss_reel::fastmath::sin_cos(x);
+            let xd = f64::from(x);
+            let err = (f64::from(s) - libm::sin(xd))
+                .abs()
+                .max((f64::from(c) - libm::cos(xd)).abs());
+            defmt::assert!(err < 2.5e-7, "x = {=f32}: error {=f64}", x, err);
+            x += 0.0137;
+        }
+    }
+
+    #[test]
+    fn quintic_transition_meets_its_end_conditions_in_f32() {
+        let s = tss_reel::schedule::BandSchedule::<f32>::paper_stage1();
+        let lo = s.eval(10_000.0 + 1e-3);
+        let hi = s.eval(30_000.0 - 1e-3);
+        defmt::assert!((lo.angle_rad + core::f32::consts::FRAC_PI_4).abs() < 1e-6);
+        defmt::assert!(lo.slope_rad_per_m.abs() < 1e-9);
+        defmt::assert!(hi.angle_rad.abs() < 1e-6);
+        defmt::assert!((hi.slope_rad_per_m - core::f32::consts::PI * 1e-5).abs() < 1e-9);
+    }
+
+    #[test]
+    fn implicit_law_residual_is_zero_in_f32() {
+        // Substituting the command back into Eqs. 27 + 29 gives it back (SPEC §5).
+        use tss_reel::law::{solve, Gains, LawInput};
+        let x = LawInput {
+            length_m: 15_000.0_f32,
+            alpha_rad: -0.6,
+            alpha_rate_radps: 1.0e-4,
+            orbit_rate_radps: 1.060_237_2e-3,
+            ref_angle_rad: -0.55,
+            ref_slope_rad_per_m: 6.0e-5,
+            ref_curvature_rad_per_m2: 3.0e-9,
+            ref_time_rate_radps: 0.0,
+            mu3: 0.0,
+            mu3_per_m: 0.0,
+            blend_weight: 0.2,
+            decay_rate_per_s: 1e-3,
+            initial_rate_mps: 0.1,
+            gains: Gains::paper(),
+        };
+        let Ok(s) = solve(&x) else {
+            defmt::panic!("no solution");
+        };
+        let dd = x.alpha_rate_radps - x.ref_slope_rad_per_m * s.rate_mps;
+        let n = x.orbit_rate_radps;
+        let u = (x.gains.k1_per_s * dd + x.gains.k2_per_s2 * s.delta_rad
+            - 1.5 * n * n * libm::sinf(2.0 * x.alpha_rad))
+            / (n + dd)
+            * x.length_m
+            / 2.0;
+        let blended = u + (x.initial_rate_mps - u) * x.blend_weight;
+        defmt::assert!(
+            (blended - s.rate_mps).abs() <= 1e-4 * s.rate_mps.abs(),
+            "y = {=f32}, Eq. 29 gives {=f32}",
+            s.rate_mps,
+            blended
+        );
+    }
+
+    #[test]
+    fn controller_never_commands_outside_the_envelope_on_garbage() {
+        use tss_reel::controller::{Config, Controller, Input};
+        let cfg = Config::<f32>::paper();
+        let mut ctl = defmt::unwrap!(Controller::new(cfg).ok());
+        let junk = [f32::NAN, f32::INFINITY, -f32::INFINITY, 1e-40, -1.0, 3.0e38, 0.0];
+        let mut tick = 0;
+        for &a in &junk {
+            for &b in &junk {
+                let o = ctl.step(&Input {
+                    tick,
+                    length_m: a,
+                    alpha_rad: b,
+                    alpha_rate_radps: a,
+                    orbit_rate_radps: b,
+                });
+                defmt::assert!(o.rate_cmd_mps.is_finite());
+                defmt::assert!(o.rate_cmd_mps.abs() <= cfg.envelope.max_rate_mps);
+                tick += 1;
+            }
+        }
+    }
 }

@@ -1,47 +1,46 @@
-//! What the firmware does on each control tick: the mission body.
+//! What the firmware does on each control tick: the reel controller flying a recorded stretch
+//! of the paper's mission.
 //!
-//! **This is the module to replace** when the real controller lands (replaying a recorded
-//! stretch of the mission through `tss_reel`'s step function). The contract with the main loop
-//! in `main.rs`, which does not change:
+//! The built-in test input ([`super::replay_data`]) is the first 900 s of `scenarios/paper.toml`
+//! as the reel MCU senses it, recorded from `tss-sim`, with a sensor dropout injected at ticks
+//! 400..450 (longer than the controller's 30-tick coast, so it goes Degraded → SafeHold and
+//! recovers). The replay implements the [`tss_reel::hal`] sensor traits; the reel drive is a
+//! telemetry sink that folds every command into a digest. The controller is the flight one:
+//! `tss_reel::controller::Controller<f32>` with the paper's configuration, stepped once per
+//! SysTick through [`tss_reel::hal::control_cycle`].
+//!
+//! The contract with the main loop in `main.rs`:
 //! - [`CONTROL_PERIOD_MS`]: the control period; one SysTick interrupt per period;
 //! - [`MAX_TICKS`]: a hard bound on the run (a mission still running then is a failure);
 //! - [`Mission::new`] once, then [`Mission::step`] once per tick with the tick index
 //!   `0, 1, 2, …`, returning [`Flow::Continue`], [`Flow::Finished`] or [`Flow::Failed`].
 //!
-//! What is logged at `info` is checked against `expected/firmware.log` by
-//! `scripts/firmware-log`; after an intended change, bless the new log with
-//! `scripts/firmware-log --bless` and review its diff.
-//!
-//! For now (placeholder until the controller lands) the mission exercises what the library has:
-//! the orbit rate of the paper's orbit, and the mass coefficients of Eq. 5 along a deployment
-//! from 2 km to 30 km, one kilometre per tick.
+//! What is logged at `info`/`warn` is checked against `expected/firmware.log` by
+//! `scripts/firmware-log`, and every logged command (and the digest of all of them) is checked
+//! bit for bit against the same core compiled for the host by `tests/firmware_replay.rs`.
 
-use tss_reel::mass::MassModel;
-use tss_reel::orbit::circular_rate_radps;
+use super::replay_data::{
+    DROPOUT_FROM_TICK, DROPOUT_UNTIL_TICK, ORBIT_RATE_RADPS, PERIOD_S, SAMPLES,
+};
+use tss_reel::controller::{Config, Controller, Flags, Output, Phase};
+use tss_reel::hal::{
+    control_cycle, Devices, ErrorKind, ErrorType, LengthSensor, OrbitRateSource, ReelDrive,
+    Swing, SwingSensor,
+};
 
-/// Control period, ms: 1 s, the period of the paper's scenario (scenarios/paper.toml, SPEC §7).
+/// Control period, ms: 1 s, the period of the paper's scenario and of the recording.
 pub const CONTROL_PERIOD_MS: u32 = 1_000;
 
+// The recording's period is the firmware's.
+const _: () = assert!(PERIOD_S == 1.0 && CONTROL_PERIOD_MS == 1_000);
 // The period must be one SysTick can produce.
 const _: () = assert!(super::clock::reload_for(CONTROL_PERIOD_MS).is_some());
 
-/// Hard bound on the number of ticks of one run.
-pub const MAX_TICKS: u32 = 1_000;
+/// Hard bound on the number of ticks of one run (the replay plus a margin).
+pub const MAX_TICKS: u32 = SAMPLES.len() as u32 + 10;
 
-/// Orbit radius of the paper's Section 6, m (R = 7078 km).
-const ORBIT_RADIUS_M: f32 = 7_078_000.0;
-
-/// A thin tether's linear density, kg/m, so that μ1 and μ3 are not trivially zero.
-const TETHER_DENSITY_KG_PER_M: f32 = 1e-3;
-
-/// Shortest tether length of the walk, m (the paper's retrieval target, 2 km).
-const FIRST_LENGTH_M: u32 = 2_000;
-
-/// Longest tether length of the walk, m (the paper's deployed length, 30 km).
-const LAST_LENGTH_M: u32 = 30_000;
-
-/// Length added on each tick, m.
-const LENGTH_STEP_M: u32 = 1_000;
+/// A status line every this many ticks.
+const LOG_EVERY_TICKS: u32 = 60;
 
 /// What the main loop does after a step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
@@ -54,23 +53,103 @@ pub enum Flow {
     Failed,
 }
 
+/// The recorded sensors, with the injected dropout.
+struct Replay;
+
+impl Replay {
+    fn sample(tick: u32) -> Result<&'static [f32; 3], ErrorKind> {
+        if (DROPOUT_FROM_TICK..DROPOUT_UNTIL_TICK).contains(&tick) {
+            return Err(ErrorKind::NoSample);
+        }
+        SAMPLES.get(tick as usize).ok_or(ErrorKind::NoSample)
+    }
+}
+
+impl ErrorType for Replay {
+    type Error = ErrorKind;
+}
+
+impl LengthSensor for Replay {
+    fn read_length_m(&mut self, tick: u32) -> Result<f32, ErrorKind> {
+        Self::sample(tick).map(|s| s[0])
+    }
+}
+
+impl SwingSensor for Replay {
+    fn read_swing(&mut self, tick: u32) -> Result<Swing, ErrorKind> {
+        Self::sample(tick).map(|s| Swing {
+            alpha_rad: s[1],
+            alpha_rate_radps: s[2],
+        })
+    }
+}
+
+/// The orbit rate of the paper's circular orbit.
+struct CircularOrbit;
+
+impl ErrorType for CircularOrbit {
+    type Error = ErrorKind;
+}
+
+impl OrbitRateSource for CircularOrbit {
+    fn read_orbit_rate_radps(&mut self, _tick: u32) -> Result<f32, ErrorKind> {
+        Ok(ORBIT_RATE_RADPS)
+    }
+}
+
+/// The reel drive of the replay: a telemetry sink that checks and fingerprints each command.
+struct TelemetryReel {
+    /// FNV-1a over the bit patterns of all rate commands (as `tests/firmware_replay.rs`).
+    digest: u32,
+    /// Commands received.
+    count: u32,
+}
+
+impl ErrorType for TelemetryReel {
+    type Error = ErrorKind;
+}
+
+impl ReelDrive for TelemetryReel {
+    fn command(&mut self, output: &Output<f32>) -> Result<(), ErrorKind> {
+        if !output.rate_cmd_mps.is_finite() {
+            return Err(ErrorKind::Device);
+        }
+        for b in output.rate_cmd_mps.to_bits().to_le_bytes() {
+            self.digest = (self.digest ^ u32::from(b)).wrapping_mul(0x0100_0193);
+        }
+        self.count += 1;
+        Ok(())
+    }
+}
+
 /// The mission's state between ticks.
 pub struct Mission {
-    /// Orbit rate n of the circular orbit, rad/s.
-    orbit_rate_radps: f32,
-    /// Masses of the main satellite, sub-satellite and tether.
-    masses: MassModel<f32>,
+    controller: Controller<f32>,
+    devices: Devices<Replay, Replay, CircularOrbit, TelemetryReel>,
+    last_phase: Phase,
 }
 
 impl Mission {
     /// Sets the mission up (called once, before the first tick).
     pub fn new() -> Self {
+        // The paper's configuration is valid by construction; a rejection would be a build
+        // defect, reported on the first tick.
+        let controller = Controller::new(Config::paper());
+        if let Err(e) = &controller {
+            defmt::error!("controller configuration rejected: {}", e);
+        }
         Self {
-            orbit_rate_radps: circular_rate_radps::<f32>(ORBIT_RADIUS_M),
-            masses: MassModel {
-                tether_density_kg_per_m: TETHER_DENSITY_KG_PER_M,
-                ..MassModel::paper()
+            controller: controller.unwrap_or_else(|_| super::exit::failure()),
+            devices: Devices {
+                length: Replay,
+                swing: Replay,
+                orbit: CircularOrbit,
+                reel: TelemetryReel {
+                    digest: 0x811c_9dc5,
+                    count: 0,
+                },
             },
+            last_phase: Phase::Deploy,
         }
     }
 
@@ -78,40 +157,56 @@ impl Mission {
     pub fn step(&mut self, tick: u32) -> Flow {
         if tick == 0 {
             defmt::info!(
-                "orbit R = {=f32} m: n = {=f32} rad/s",
-                ORBIT_RADIUS_M,
-                self.orbit_rate_radps
+                "replay: {=usize} s of scenarios/paper.toml, n = {=f32} rad/s, dropout at ticks {=u32}..{=u32}",
+                SAMPLES.len(),
+                ORBIT_RATE_RADPS,
+                DROPOUT_FROM_TICK,
+                DROPOUT_UNTIL_TICK
             );
-            if !self.orbit_rate_radps.is_finite() {
-                defmt::error!("orbit rate is not finite");
-                return Flow::Failed;
-            }
+        }
+        if tick as usize >= SAMPLES.len() {
+            let reel = &self.devices.reel;
+            defmt::info!(
+                "replay done: {=u32} commands, digest={=u32:#010x}",
+                reel.count,
+                reel.digest
+            );
+            return Flow::Finished;
         }
 
-        let length_m = FIRST_LENGTH_M.saturating_add(tick.saturating_mul(LENGTH_STEP_M));
-        // Lengths up to 30 km are exact in f32 (< 2^24).
-        let c = self.masses.coefficients(length_m as f32);
-        defmt::info!(
-            "tick {=u32}: l = {=u32} m: mu1 = {=f32}, mu2 = {=f32}, mu3 = {=f32}, M* = {=f32} kg",
-            tick,
-            length_m,
-            c.mu1,
-            c.mu2,
-            c.mu3,
-            c.reduced_kg
-        );
-        let all_finite = [c.mu1, c.mu2, c.mu3, c.reduced_kg]
-            .iter()
-            .all(|x| x.is_finite());
-        if !all_finite {
-            defmt::error!("mass coefficients are not finite at l = {=u32} m", length_m);
+        let cycle = control_cycle(&mut self.controller, tick, &mut self.devices);
+        let o = &cycle.output;
+        if let Some(e) = cycle.reel_error {
+            defmt::error!("t={=u32} reel refused the command: {}", tick, e);
             return Flow::Failed;
         }
-
-        if length_m >= LAST_LENGTH_M {
-            Flow::Finished
-        } else {
-            Flow::Continue
+        let event = o.flags.contains(Flags::HEALTH_CHANGED) || o.phase != self.last_phase;
+        self.last_phase = o.phase;
+        if event {
+            defmt::warn!(
+                "t={=u32} {} {} fault={} cmd={=f32} m/s l_est={=f32} m",
+                tick,
+                o.phase,
+                o.health,
+                o.fault,
+                o.rate_cmd_mps,
+                o.length_estimate_m
+            );
+        } else if tick % LOG_EVERY_TICKS == 0 {
+            defmt::info!(
+                "t={=u32} {} {}: l={=f32} m alpha_ref={=f32} rad delta={=f32} rad cmd={=f32} m/s accel={=f32} m/s2 E={=f32} flags={=u32:#x}",
+                tick,
+                o.phase,
+                o.health,
+                o.length_estimate_m,
+                o.alpha_ref_rad,
+                o.delta_rad,
+                o.rate_cmd_mps,
+                o.accel_cmd_mps2,
+                o.blend_weight,
+                o.flags.0
+            );
         }
+        Flow::Continue
     }
 }

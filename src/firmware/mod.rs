@@ -13,3 +13,4 @@ use panic_probe as _;
 pub mod clock;
 pub mod exit;
 pub mod mission;
+pub mod replay_data;
