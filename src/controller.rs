@@ -197,6 +197,9 @@ pub struct Controller<T> {
     last_tick: Option<u32>,
     last_rate_cmd_mps: T,
     length_estimate_m: T,
+    /// `true` once a sample has anchored the length estimate (until then there is no
+    /// prediction to check a sensed length against).
+    anchored: bool,
     monitor: Monitor<T>,
     existence: ExistenceMonitor<T>,
 }
@@ -238,6 +241,7 @@ impl<T: Real> Controller<T> {
             last_tick: None,
             last_rate_cmd_mps: cfg.initial_rate_mps,
             length_estimate_m: T::ZERO,
+            anchored: false,
             monitor: Monitor::new(),
             cfg,
         })
@@ -311,10 +315,12 @@ impl<T: Real> Controller<T> {
         let Some(x) = sample else {
             return self.reject(tick, Fault::Sensor(Sensor::Missing), None, flags);
         };
-        // In safe hold the prediction is not trusted; the first sample re-anchors it.
-        let expected = match (first, self.health) {
-            (true, _) | (_, Health::SafeHold) => None,
-            _ => Some(self.length_estimate_m),
+        // Before the first accepted sample, and in safe hold, there is no trusted prediction:
+        // the next valid sample (re-)anchors it.
+        let expected = if self.anchored && self.health != Health::SafeHold {
+            Some(self.length_estimate_m)
+        } else {
+            None
         };
         let env = self.cfg.envelope;
         if let Err(s) = self
@@ -324,14 +330,14 @@ impl<T: Real> Controller<T> {
             return self.reject(tick, Fault::Sensor(s), None, flags);
         }
         self.length_estimate_m = x.length_m;
+        self.anchored = true;
 
         let tau_s = T::from_u32(tick.saturating_sub(self.stage_start_tick)) * dt;
         let reference = self.reference(tau_s, x.length_m);
         if self.health == Health::SafeHold {
             self.good_ticks = self.good_ticks.saturating_add(1);
             if self.good_ticks < self.cfg.monitor.recovery_ticks {
-                let hold = self.hold(tick, &reference, flags, None);
-                return hold;
+                return self.hold(tick, &reference, flags, None);
             }
             // Recovered: re-engage the law through the Eq. 29 blend from the current rate.
             self.restart_blend(tick, self.last_rate_cmd_mps, &mut flags);

@@ -172,6 +172,17 @@ fn a_short_gap_only_degrades() {
 }
 
 #[test]
+fn a_missing_first_sample_does_not_poison_the_length_check() {
+    // No sample at tick 0: the estimate has nothing to start from, so the first real sample
+    // (at any length) anchors it instead of failing as a jump.
+    let mut ctl = paper();
+    assert_eq!(ctl.step_missing(0).health, Health::Degraded);
+    let o = ctl.step(&sample(1, 12_345.0));
+    assert_eq!(o.health, Health::Nominal, "{o:?}");
+    assert_eq!(o.length_estimate_m, 12_345.0);
+}
+
+#[test]
 fn length_glitch_is_rejected_and_the_prediction_used() {
     let mut ctl = paper();
     let o = ctl.step(&sample(0, 5_000.0));
