@@ -176,6 +176,38 @@ pub struct Output<T> {
     pub fault: Option<Fault>,
 }
 
+/// Capacity of the controller's event queue ([`Controller::pop_event`]).
+pub const EVENT_CAPACITY: usize = 16;
+
+/// Something that happened in one step, worth telling the ground about once.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum EventKind {
+    /// The input health changed.
+    Health {
+        /// Before.
+        from: Health,
+        /// After.
+        to: Health,
+    },
+    /// A fault was raised (recorded when it differs from the previous fault).
+    Fault(Fault),
+    /// The mission phase changed.
+    Phase(Phase),
+    /// The Eq. 29 blend restarted (a stage began, or the controller recovered).
+    BlendRestart,
+}
+
+/// An event and the tick it happened at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub struct Event {
+    /// The tick.
+    pub tick: u32,
+    /// What happened.
+    pub kind: EventKind,
+}
+
 /// Bound on the reported [`Output::equilibrium_margin`] (x grows as 1/l toward docking).
 pub const MAX_REPORTED_MARGIN: f64 = 1e6;
 
@@ -202,6 +234,10 @@ pub struct Controller<T> {
     anchored: bool,
     monitor: Monitor<T>,
     existence: ExistenceMonitor<T>,
+    /// Events not yet read, oldest first; when full the oldest is dropped and counted.
+    events: heapless::Deque<Event, EVENT_CAPACITY>,
+    events_dropped: u32,
+    last_fault: Option<Fault>,
 }
 
 /// The law's contribution to an output.
@@ -242,6 +278,9 @@ impl<T: Real> Controller<T> {
             last_rate_cmd_mps: cfg.initial_rate_mps,
             length_estimate_m: T::ZERO,
             anchored: false,
+            events: heapless::Deque::new(),
+            events_dropped: 0,
+            last_fault: None,
             monitor: Monitor::new(),
             cfg,
         })
@@ -262,6 +301,28 @@ impl<T: Real> Controller<T> {
         self.health
     }
 
+    /// The oldest unread event (health and phase changes, faults, blend restarts), if any.
+    ///
+    /// The queue holds [`EVENT_CAPACITY`] events; read it every period so none are dropped
+    /// ([`Controller::events_dropped`] counts any that were).
+    pub fn pop_event(&mut self) -> Option<Event> {
+        self.events.pop_front()
+    }
+
+    /// Events dropped because the queue was full when they happened.
+    pub fn events_dropped(&self) -> u32 {
+        self.events_dropped
+    }
+
+    fn record(&mut self, tick: u32, kind: EventKind) {
+        if self.events.is_full() {
+            self.events.pop_front();
+            self.events_dropped = self.events_dropped.saturating_add(1);
+        }
+        // Cannot fail: there is room now.
+        let _ = self.events.push_back(Event { tick, kind });
+    }
+
     /// Asks for stage 2 (retrieval) to begin at the next step, whatever the configured start.
     pub fn start_stage2(&mut self) {
         self.stage2_requested = true;
@@ -279,6 +340,33 @@ impl<T: Real> Controller<T> {
     }
 
     fn advance(&mut self, tick: u32, sample: Option<&Input<T>>) -> Output<T> {
+        let (health, phase) = (self.health, self.phase);
+        let out = self.advance_inner(tick, sample);
+        if out.health != health {
+            self.record(
+                tick,
+                EventKind::Health {
+                    from: health,
+                    to: out.health,
+                },
+            );
+        }
+        if out.phase != phase {
+            self.record(tick, EventKind::Phase(out.phase));
+        }
+        if out.fault.is_some() && out.fault != self.last_fault {
+            if let Some(f) = out.fault {
+                self.record(tick, EventKind::Fault(f));
+            }
+        }
+        self.last_fault = out.fault;
+        if out.flags.contains(Flags::BLEND_RESTART) {
+            self.record(tick, EventKind::BlendRestart);
+        }
+        out
+    }
+
+    fn advance_inner(&mut self, tick: u32, sample: Option<&Input<T>>) -> Output<T> {
         let mut flags = Flags::default();
         let dt = self.cfg.period_s;
         // A tick that goes backwards is a bad sample; time does not move.

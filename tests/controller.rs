@@ -349,3 +349,57 @@ fn early_deployment_is_flagged_outside_the_equilibrium_region() {
     assert!(!o2.flags.contains(Flags::NO_EQUILIBRIUM), "{o2:?}");
     assert!((o2.equilibrium_margin - 1.5).abs() < 0.05);
 }
+
+#[test]
+fn events_tell_each_change_once_and_count_what_overflows() {
+    use tss_reel::controller::{EventKind, EVENT_CAPACITY};
+    let mut ctl = paper();
+    ctl.step(&sample(0, 100.0));
+    assert_eq!(
+        ctl.pop_event().map(|e| e.kind),
+        Some(EventKind::BlendRestart)
+    );
+    assert_eq!(ctl.pop_event(), None);
+    // A 40-tick dropout: one Health(Degraded) + one Fault(Missing), then one Health(SafeHold).
+    for t in 1..41 {
+        ctl.step_missing(t);
+    }
+    let kinds: Vec<_> = std::iter::from_fn(|| ctl.pop_event())
+        .map(|e| (e.tick, e.kind))
+        .collect();
+    assert_eq!(
+        kinds,
+        vec![
+            (
+                1,
+                EventKind::Health {
+                    from: Health::Nominal,
+                    to: Health::Degraded
+                }
+            ),
+            (1, EventKind::Fault(Fault::Sensor(Sensor::Missing))),
+            (
+                31,
+                EventKind::Health {
+                    from: Health::Degraded,
+                    to: Health::SafeHold
+                }
+            ),
+        ]
+    );
+    // Alternating faults overflow the queue: the oldest are dropped and counted.
+    let mut t = 41;
+    for _ in 0..EVENT_CAPACITY {
+        ctl.step(&Input {
+            length_m: f32::NAN,
+            ..sample(t, 100.0)
+        });
+        ctl.step_missing(t + 1);
+        t += 2;
+    }
+    assert!(ctl.events_dropped() > 0);
+    assert_eq!(
+        std::iter::from_fn(|| ctl.pop_event()).count(),
+        EVENT_CAPACITY
+    );
+}

@@ -22,10 +22,10 @@
 use super::replay_data::{
     DROPOUT_FROM_TICK, DROPOUT_UNTIL_TICK, ORBIT_RATE_RADPS, PERIOD_S, SAMPLES,
 };
-use tss_reel::controller::{Config, Controller, Flags, Output, Phase};
+use tss_reel::controller::{Config, Controller, Output};
 use tss_reel::hal::{
-    control_cycle, Devices, ErrorKind, ErrorType, LengthSensor, OrbitRateSource, ReelDrive,
-    Swing, SwingSensor,
+    control_cycle, Devices, ErrorKind, ErrorType, LengthSensor, OrbitRateSource, ReelDrive, Swing,
+    SwingSensor,
 };
 
 /// Control period, ms: 1 s, the period of the paper's scenario and of the recording.
@@ -126,7 +126,6 @@ impl ReelDrive for TelemetryReel {
 pub struct Mission {
     controller: Controller<f32>,
     devices: Devices<Replay, Replay, CircularOrbit, TelemetryReel>,
-    last_phase: Phase,
 }
 
 impl Mission {
@@ -149,7 +148,6 @@ impl Mission {
                     count: 0,
                 },
             },
-            last_phase: Phase::Deploy,
         }
     }
 
@@ -167,9 +165,10 @@ impl Mission {
         if tick as usize >= SAMPLES.len() {
             let reel = &self.devices.reel;
             defmt::info!(
-                "replay done: {=u32} commands, digest={=u32:#010x}",
+                "replay done: {=u32} commands, digest={=u32:#010x}, events dropped: {=u32}",
                 reel.count,
-                reel.digest
+                reel.digest,
+                self.controller.events_dropped()
             );
             return Flow::Finished;
         }
@@ -180,19 +179,14 @@ impl Mission {
             defmt::error!("t={=u32} reel refused the command: {}", tick, e);
             return Flow::Failed;
         }
-        let event = o.flags.contains(Flags::HEALTH_CHANGED) || o.phase != self.last_phase;
-        self.last_phase = o.phase;
-        if event {
-            defmt::warn!(
-                "t={=u32} {} {} fault={} cmd={=f32} m/s l_est={=f32} m",
-                tick,
-                o.phase,
-                o.health,
-                o.fault,
-                o.rate_cmd_mps,
-                o.length_estimate_m
-            );
-        } else if tick % LOG_EVERY_TICKS == 0 {
+        // Every health or phase change, fault and blend restart, once, from the controller's
+        // bounded event queue.
+        let mut events = false;
+        while let Some(ev) = self.controller.pop_event() {
+            defmt::warn!("t={=u32} event: {}", ev.tick, ev.kind);
+            events = true;
+        }
+        if events || tick.is_multiple_of(LOG_EVERY_TICKS) {
             defmt::info!(
                 "t={=u32} {} {}: l={=f32} m alpha_ref={=f32} rad delta={=f32} rad cmd={=f32} m/s accel={=f32} m/s2 E={=f32} flags={=u32:#x}",
                 tick,
