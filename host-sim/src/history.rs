@@ -75,4 +75,7 @@ pub struct History {
     /// Length at every Table-1 instant requested by the caller of `sim::run` (t_s, length_m), in order,
     /// taken at the exact control tick (not interpolated).
     pub probes: Vec<(f64, f64)>,
+    /// Faults, health, tension and envelope over every control tick of the run (see
+    /// `faults::FaultSummary`; all zero for a history not made by `sim::run`).
+    pub faults: crate::faults::FaultSummary,
 }

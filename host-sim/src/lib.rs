@@ -2,10 +2,12 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod faults;
 pub mod history;
 pub mod output;
 pub mod plant;
 pub mod plots;
+pub mod reel;
 pub mod report;
 pub mod run_cmd;
 pub mod scenario;

@@ -351,6 +351,7 @@ mod tests {
         let hist = History {
             samples,
             probes: vec![],
+            ..History::default()
         };
         let s = summarize(&scenario, &hist);
         assert!((s.landmarks[0].t_s.unwrap() - 2.5 * h).abs() < 1e-6);

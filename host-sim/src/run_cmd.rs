@@ -238,6 +238,10 @@ where
     let report = format!("{}\n{}", summary.render(), table.render());
     let summary_txt = dir.join("summary.txt");
     write_file(&summary_txt, |w| w.write_all(report.as_bytes()))?;
+    // The fault summary (faults.rs): printed after the report and written to faults.txt.
+    let faults = crate::faults::render_fault_summary(&scenario, &history.faults);
+    write_file(&dir.join("faults.txt"), |w| w.write_all(faults.as_bytes()))?;
+    let report = format!("{report}\n{faults}");
     let (figures, figure_error) = match plots::write_figures(&dir, &scenario, &history) {
         Ok(paths) => (paths, None),
         Err(e) => (Vec::new(), Some(e)),

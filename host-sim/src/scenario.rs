@@ -34,6 +34,19 @@ pub struct Scenario {
     /// 40 km, wide enough never to act in the paper's mission).
     #[serde(default)]
     pub envelope: EnvelopeSection,
+    /// Sensor errors injected between the plant and the controller (default: perfect sensors).
+    #[serde(default)]
+    pub sensors: SensorsSection,
+    /// Injected faults: dropouts, corrupted readings, length-encoder glitches (default: none).
+    #[serde(default)]
+    pub faults: FaultsSection,
+    /// The physical reel drive: lag and its own saturation (default: ideal, the command is the
+    /// reel's rate).
+    #[serde(default)]
+    pub reel: ReelSection,
+    /// Thresholds of the controller's sensor monitor (defaults: `MonitorConfig::default_for_period`).
+    #[serde(default)]
+    pub monitor: MonitorSection,
 }
 
 /// `[envelope]`: the reel's operating limits.
@@ -59,6 +72,209 @@ impl Default for EnvelopeSection {
             max_length_m: 40_000.0,
         }
     }
+}
+
+/// `[sensors]`: what the controller reads is the plant's truth plus these errors, applied in the
+/// order bias, noise, quantisation, then a stuck window freezes the reading (SPEC: sensed
+/// values are rounded to the controller's scalar type last). The noise is reproducible: one
+/// seeded generator per sensor (see `faults::Pcg32`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorsSection {
+    /// Seed of the noise generators (the same seed gives the same run, on any machine).
+    #[serde(default)]
+    pub seed: u64,
+    /// The length encoder (units: m).
+    #[serde(default)]
+    pub length: SensorSection,
+    /// The in-plane angle sensor α (units: rad).
+    #[serde(default)]
+    pub alpha: SensorSection,
+    /// The in-plane rate sensor α̇ (units: rad/s).
+    #[serde(default)]
+    pub alpha_rate: SensorSection,
+}
+
+/// `[sensors.length]`, `[sensors.alpha]`, `[sensors.alpha_rate]`: one sensor's errors, in the
+/// sensor's own unit (m, rad, rad/s).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorSection {
+    /// Standard deviation of white Gaussian noise added every sample (0 = none).
+    #[serde(default)]
+    pub noise_std: f64,
+    /// Constant offset added to every sample.
+    #[serde(default)]
+    pub bias: f64,
+    /// Quantisation step: the reading is rounded to a multiple of it (0 = none).
+    #[serde(default)]
+    pub quantum: f64,
+    /// The sensor repeats the reading it gave at this time, s (inf = never).
+    #[serde(default = "infinity")]
+    pub stuck_from_s: f64,
+    /// … until this time, s (inf = to the end of the run).
+    #[serde(default = "infinity")]
+    pub stuck_until_s: f64,
+}
+
+impl Default for SensorSection {
+    fn default() -> Self {
+        Self {
+            noise_std: 0.0,
+            bias: 0.0,
+            quantum: 0.0,
+            stuck_from_s: f64::INFINITY,
+            stuck_until_s: f64::INFINITY,
+        }
+    }
+}
+
+/// `[faults]`: injected faults. Windows are half-open, [from_s, until_s), on the control ticks.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FaultsSection {
+    /// `[[faults.dropout]]`: no sample arrives (the controller's `step_missing`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub dropout: Vec<WindowSection>,
+    /// `[[faults.corrupt]]`: one sensor reads a fixed value (NaN, inf, anything).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub corrupt: Vec<CorruptSection>,
+    /// `[[faults.length_glitch]]`: the length encoder is off by `size_m` for one tick.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub length_glitch: Vec<GlitchSection>,
+}
+
+/// A time window [from_s, until_s).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WindowSection {
+    /// Start, s.
+    pub from_s: f64,
+    /// End (excluded), s; inf = to the end of the run.
+    pub until_s: f64,
+}
+
+/// The sensors a `[[faults.corrupt]]` entry can hit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SensorName {
+    /// The length encoder.
+    Length,
+    /// The α sensor.
+    Alpha,
+    /// The α̇ sensor.
+    AlphaRate,
+    /// The orbit-rate source.
+    OrbitRate,
+}
+
+impl SensorName {
+    /// The name as written in scenario files.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Length => "length",
+            Self::Alpha => "alpha",
+            Self::AlphaRate => "alpha_rate",
+            Self::OrbitRate => "orbit_rate",
+        }
+    }
+}
+
+/// `[[faults.corrupt]]`: `sensor` reads `value` during [from_s, until_s).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CorruptSection {
+    /// Which sensor.
+    pub sensor: SensorName,
+    /// Start, s.
+    pub from_s: f64,
+    /// End (excluded), s; inf = to the end of the run.
+    pub until_s: f64,
+    /// The reading, in the sensor's unit; `nan`, `inf` and `-inf` are allowed (that is the
+    /// point).
+    pub value: f64,
+}
+
+/// `[[faults.length_glitch]]`: the length reading of the tick at `at_s` is off by `size_m`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GlitchSection {
+    /// When, s (the tick at or after it).
+    pub at_s: f64,
+    /// Size of the error, m.
+    pub size_m: f64,
+}
+
+/// `[reel]`: the physical reel drive between the command and the tether. Its actual rate v
+/// follows the command u as a first-order lag, dv/dt = (u − v)/lag_s, with its own rate and
+/// acceleration saturation (separate from the controller's `[envelope]`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReelSection {
+    /// Time constant of the lag, s (0 = the rate follows the command at once).
+    #[serde(default)]
+    pub lag_s: f64,
+    /// Largest rate the drive can reach, m/s (inf = no limit).
+    #[serde(default = "infinity")]
+    pub max_rate_mps: f64,
+    /// Largest acceleration the drive can produce, m/s² (inf = no limit).
+    #[serde(default = "infinity")]
+    pub max_accel_mps2: f64,
+}
+
+impl Default for ReelSection {
+    fn default() -> Self {
+        Self {
+            lag_s: 0.0,
+            max_rate_mps: f64::INFINITY,
+            max_accel_mps2: f64::INFINITY,
+        }
+    }
+}
+
+/// `[monitor]`: the controller's sensor checks and fault timing (`tss_reel`'s `MonitorConfig`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MonitorSection {
+    /// Ticks without a usable sample during which the controller coasts before safe hold.
+    pub coast_ticks: u32,
+    /// Consecutive valid samples needed to leave safe hold.
+    pub recovery_ticks: u32,
+    /// Largest accepted |sensed − predicted| length, m.
+    pub length_jump_m: f64,
+    /// Largest accepted α jump per tick beyond α̇·Δt, rad.
+    pub alpha_jump_rad: f64,
+    /// Identical α readings in a row (with α̇ implying motion) that make a stuck sensor.
+    pub stuck_ticks: u32,
+    /// Implied motion ∫|α̇|dt over the identical readings a stuck verdict needs, rad.
+    pub stuck_motion_rad: f64,
+    /// Largest plausible |α̇|, rad/s.
+    pub max_alpha_rate_radps: f64,
+    /// Smallest plausible orbit rate, rad/s.
+    pub min_orbit_rate_radps: f64,
+    /// Largest plausible orbit rate, rad/s.
+    pub max_orbit_rate_radps: f64,
+}
+
+impl Default for MonitorSection {
+    fn default() -> Self {
+        let m = tss_reel::controller::MonitorConfig::<f64>::default_for_period();
+        Self {
+            coast_ticks: m.coast_ticks,
+            recovery_ticks: m.recovery_ticks,
+            length_jump_m: m.length_jump_m,
+            alpha_jump_rad: m.alpha_jump_rad,
+            stuck_ticks: m.stuck_ticks,
+            stuck_motion_rad: m.stuck_motion_rad,
+            max_alpha_rate_radps: m.max_alpha_rate_radps,
+            min_orbit_rate_radps: m.min_orbit_rate_radps,
+            max_orbit_rate_radps: m.max_orbit_rate_radps,
+        }
+    }
+}
+
+fn infinity() -> f64 {
+    f64::INFINITY
 }
 
 /// `[orbit]`
@@ -377,7 +593,13 @@ impl Scenario {
             return Ok(scenario);
         }
         for p in &mut problems {
-            p.from_override = overridden.contains(&p.field);
+            // `faults.dropout[0].from_s` came from `--set faults.dropout=[...]`.
+            let element_of = |k: &String| {
+                p.field
+                    .strip_prefix(k.as_str())
+                    .is_some_and(|r| r.starts_with('['))
+            };
+            p.from_override = overridden.contains(&p.field) || overridden.iter().any(element_of);
         }
         Err(ScenarioError::Invalid {
             file: file.to_string(),
@@ -635,6 +857,82 @@ impl Scenario {
                 false,
             );
         }
+
+        // [sensors]: finite errors; a stuck window that does not end before it starts.
+        for (name, sensor) in [
+            ("sensors.length", &s.sensors.length),
+            ("sensors.alpha", &s.sensors.alpha),
+            ("sensors.alpha_rate", &s.sensors.alpha_rate),
+        ] {
+            v.non_negative(&format!("{name}.noise_std"), sensor.noise_std);
+            v.finite(&format!("{name}.bias"), sensor.bias);
+            v.non_negative(&format!("{name}.quantum"), sensor.quantum);
+            v.window(
+                &format!("{name}.stuck_from_s"),
+                sensor.stuck_from_s,
+                &format!("{name}.stuck_until_s"),
+                sensor.stuck_until_s,
+                true,
+            );
+        }
+
+        // [faults]: windows that start at a finite time ≥ 0 and end after they start.
+        let f = &s.faults;
+        for (i, w) in f.dropout.iter().enumerate() {
+            let at = format!("faults.dropout[{i}]");
+            v.window(
+                &format!("{at}.from_s"),
+                w.from_s,
+                &format!("{at}.until_s"),
+                w.until_s,
+                false,
+            );
+        }
+        for (i, c) in f.corrupt.iter().enumerate() {
+            let at = format!("faults.corrupt[{i}]");
+            v.window(
+                &format!("{at}.from_s"),
+                c.from_s,
+                &format!("{at}.until_s"),
+                c.until_s,
+                false,
+            );
+        }
+        for (i, g) in f.length_glitch.iter().enumerate() {
+            v.non_negative(&format!("faults.length_glitch[{i}].at_s"), g.at_s);
+            v.finite(&format!("faults.length_glitch[{i}].size_m"), g.size_m);
+        }
+
+        // [reel]: a lag ≥ 0; saturations above 0 (inf = none).
+        v.non_negative("reel.lag_s", s.reel.lag_s);
+        v.limit("reel.max_rate_mps", s.reel.max_rate_mps);
+        v.limit("reel.max_accel_mps2", s.reel.max_accel_mps2);
+
+        // [monitor]: the same rules as `MonitorConfig::validate`, named by scenario key.
+        let m = &s.monitor;
+        for (field, ticks) in [
+            ("monitor.coast_ticks", m.coast_ticks),
+            ("monitor.recovery_ticks", m.recovery_ticks),
+            ("monitor.stuck_ticks", m.stuck_ticks),
+        ] {
+            v.check(ticks >= 1, field, ticks.to_string(), "must be at least 1");
+        }
+        v.positive("monitor.length_jump_m", m.length_jump_m);
+        v.positive("monitor.alpha_jump_rad", m.alpha_jump_rad);
+        v.positive("monitor.stuck_motion_rad", m.stuck_motion_rad);
+        v.positive("monitor.max_alpha_rate_radps", m.max_alpha_rate_radps);
+        let min_ok = v.positive("monitor.min_orbit_rate_radps", m.min_orbit_rate_radps);
+        if v.positive("monitor.max_orbit_rate_radps", m.max_orbit_rate_radps) && min_ok {
+            v.check(
+                m.max_orbit_rate_radps > m.min_orbit_rate_radps,
+                "monitor.max_orbit_rate_radps",
+                num(m.max_orbit_rate_radps),
+                &format!(
+                    "must be above monitor.min_orbit_rate_radps = {}",
+                    num(m.min_orbit_rate_radps)
+                ),
+            );
+        }
         v.problems
     }
 }
@@ -670,6 +968,41 @@ impl Validator {
     }
     fn non_negative(&mut self, field: &str, x: f64) -> bool {
         self.finite(field, x) && self.check(x >= 0.0, field, num(x), "must not be negative")
+    }
+    /// A saturation limit: above 0, `inf` meaning none (NaN is rejected).
+    fn limit(&mut self, field: &str, x: f64) -> bool {
+        self.check(x > 0.0, field, num(x), "must be above 0 (inf = no limit)")
+    }
+    /// A window [from, until): `from` finite and ≥ 0 (or inf = never, when `never_ok`),
+    /// `until` after `from` (inf = to the end of the run; equal to `from` only when both are
+    /// inf).
+    fn window(
+        &mut self,
+        from_field: &str,
+        from: f64,
+        until_field: &str,
+        until: f64,
+        never_ok: bool,
+    ) {
+        let from_ok = if never_ok && from == f64::INFINITY {
+            true
+        } else {
+            self.non_negative(from_field, from)
+        };
+        let until_ok = self.check(
+            !until.is_nan(),
+            until_field,
+            num(until),
+            "must be a number (inf = to the end of the run)",
+        );
+        if from_ok && until_ok && from.is_finite() {
+            self.check(
+                until > from,
+                until_field,
+                num(until),
+                &format!("must be after {from_field} = {}", num(from)),
+            );
+        }
     }
     fn angle_in_open_range(&mut self, field: &str, x: f64, (lo, hi): (f64, f64), range: &str) {
         if self.finite(field, x) {
@@ -756,9 +1089,23 @@ pub struct Schema {
     pub leaves: BTreeMap<String, LeafKind>,
     /// Dotted keys of the sections (tables), e.g. `stage1`.
     pub tables: BTreeSet<String>,
+    /// Dotted keys of the arrays of tables, e.g. `faults.dropout` (`[[faults.dropout]]`); the
+    /// keys of one element are in `leaves` under the array's key, e.g. `faults.dropout.from_s`.
+    pub arrays: BTreeSet<String>,
 }
 
 impl Schema {
+    /// The array of tables that `key` is a field of an element of, if any.
+    pub fn array_of(&self, key: &str) -> Option<&str> {
+        self.arrays
+            .iter()
+            .find(|a| {
+                key.strip_prefix(a.as_str())
+                    .is_some_and(|r| r.starts_with('.'))
+            })
+            .map(String::as_str)
+    }
+
     /// The keys directly under `prefix` ("" for the top level), comma-separated.
     fn keys_under(&self, prefix: &str) -> String {
         let under = |k: &&String| match prefix {
@@ -893,6 +1240,15 @@ impl<'de> serde::Deserializer<'de> for Tracer<'_> {
             out: self.out,
         })
     }
+    fn deserialize_seq<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, TraceError> {
+        // An array of tables: trace one element at the array's own path.
+        self.out.arrays.insert(self.path.clone());
+        v.visit_seq(TraceSeq {
+            path: self.path,
+            done: false,
+            out: self.out,
+        })
+    }
     fn deserialize_enum<V: serde::de::Visitor<'de>>(
         self,
         _name: &'static str,
@@ -906,8 +1262,33 @@ impl<'de> serde::Deserializer<'de> for Tracer<'_> {
     }
 
     serde::forward_to_deserialize_any! {
-        i128 u128 char bytes byte_buf unit unit_struct newtype_struct seq tuple
+        i128 u128 char bytes byte_buf unit unit_struct newtype_struct tuple
         tuple_struct map identifier ignored_any
+    }
+}
+
+struct TraceSeq<'a> {
+    path: String,
+    done: bool,
+    out: &'a mut Schema,
+}
+
+impl<'de> serde::de::SeqAccess<'de> for TraceSeq<'_> {
+    type Error = TraceError;
+
+    fn next_element_seed<S: serde::de::DeserializeSeed<'de>>(
+        &mut self,
+        seed: S,
+    ) -> Result<Option<S::Value>, TraceError> {
+        if self.done {
+            return Ok(None);
+        }
+        self.done = true;
+        seed.deserialize(Tracer {
+            path: self.path.clone(),
+            out: &mut *self.out,
+        })
+        .map(Some)
     }
 }
 
@@ -981,7 +1362,9 @@ fn check_table(
 ) -> Result<(), ScenarioError> {
     for (key, value) in table {
         let full = join_key(prefix, key);
-        if let Some(kind) = schema.leaves.get(&full) {
+        if schema.arrays.contains(&full) {
+            check_array(value, &full, schema, file, origin)?;
+        } else if let Some(kind) = schema.leaves.get(&full) {
             if !kind.accepts(value) {
                 return Err(ScenarioError::WrongType {
                     file: file.to_string(),
@@ -1011,6 +1394,36 @@ fn check_table(
                 key: full,
                 hint: hint_for(schema, prefix),
             });
+        }
+    }
+    Ok(())
+}
+
+/// Checks an array of tables (`[[key]]`): every element is a table of the element's keys.
+fn check_array(
+    value: &toml::Value,
+    key: &str,
+    schema: &Schema,
+    file: &str,
+    origin: &str,
+) -> Result<(), ScenarioError> {
+    let wrong = || ScenarioError::WrongType {
+        file: file.to_string(),
+        origin: origin.to_string(),
+        key: key.to_string(),
+        value: value.to_string(),
+        message: format!(
+            "must be an array of tables ([[{key}]], or inline [{{ {} }}, ...])",
+            schema.keys_under(key)
+        ),
+    };
+    let toml::Value::Array(items) = value else {
+        return Err(wrong());
+    };
+    for item in items {
+        match item {
+            toml::Value::Table(t) => check_table(t, key, schema, file, origin)?,
+            _ => return Err(wrong()),
         }
     }
     Ok(())
@@ -1052,6 +1465,19 @@ fn apply_override(
         ));
     }
     let origin = format!("--set {arg}: ");
+    if let Some(array) = schema.array_of(key) {
+        return Err(bad(&format!(
+            "`{array}` is an array of tables; set it whole, e.g. \
+             {array}=[{{ {} }}]",
+            schema.keys_under(array)
+        )));
+    }
+    if schema.arrays.contains(key) {
+        let value = parse_override_value(raw);
+        check_array(&value, key, schema, file, &origin)?;
+        insert_dotted(table, key, value).map_err(|m| bad(&m))?;
+        return Ok(key.to_string());
+    }
     let Some(&kind) = schema.leaves.get(key) else {
         let prefix = key.rsplit_once('.').map_or("", |(p, _)| p);
         let hint = if schema.tables.contains(key) {
@@ -1087,8 +1513,14 @@ fn apply_override(
             message: kind.describe(),
         });
     }
+    insert_dotted(table, key, value).map_err(|m| bad(&m))?;
+    Ok(key.to_string())
+}
+
+/// Sets dotted `key` of `table` to `value`, creating sections as needed.
+fn insert_dotted(table: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), String> {
     let parts: Vec<&str> = key.split('.').collect();
-    let (last, sections) = parts.split_last().ok_or_else(|| bad("empty key"))?;
+    let (last, sections) = parts.split_last().ok_or("empty key")?;
     let mut cursor = table;
     let mut walked = String::new();
     for part in sections {
@@ -1098,11 +1530,11 @@ fn apply_override(
             .or_insert_with(|| toml::Value::Table(toml::Table::new()));
         cursor = match entry {
             toml::Value::Table(t) => t,
-            _ => return Err(bad(&format!("`{walked}` in the file is not a table"))),
+            _ => return Err(format!("`{walked}` in the file is not a table")),
         };
     }
     cursor.insert(last.to_string(), value);
-    Ok(key.to_string())
+    Ok(())
 }
 
 /// Turns a deserialization error of the (already schema-checked) table into a clear message;
@@ -1274,8 +1706,118 @@ max_length_m = 40_000.0
             }
         }
         walk(&value, "", &mut found);
-        let expected: BTreeSet<String> = s.leaves.keys().cloned().collect();
+        // The base has no faults, so no element of an array of tables is serialized.
+        let expected: BTreeSet<String> = s
+            .leaves
+            .keys()
+            .filter(|k| s.array_of(k).is_none())
+            .cloned()
+            .collect();
         assert_eq!(found, expected);
+        for array in ["faults.dropout", "faults.corrupt", "faults.length_glitch"] {
+            assert!(s.arrays.contains(array), "{array}");
+        }
+        assert_eq!(
+            s.leaves.get("faults.dropout.until_s"),
+            Some(&LeafKind::Float)
+        );
+        assert_eq!(
+            s.leaves.get("faults.corrupt.sensor"),
+            Some(&LeafKind::OneOf(&[
+                "length",
+                "alpha",
+                "alpha_rate",
+                "orbit_rate"
+            ]))
+        );
+    }
+
+    #[test]
+    fn fault_sections_default_to_a_perfect_system() {
+        let s = load(&[]).unwrap();
+        assert_eq!(s.sensors, SensorsSection::default());
+        assert!(s.faults.dropout.is_empty() && s.faults.corrupt.is_empty());
+        assert_eq!(s.reel.lag_s, 0.0);
+        assert_eq!(s.reel.max_rate_mps, f64::INFINITY);
+        assert_eq!(s.monitor, MonitorSection::default());
+        assert_eq!(s.monitor.coast_ticks, 30);
+        assert_eq!(s.monitor.length_jump_m, 20.0);
+    }
+
+    #[test]
+    fn fault_injection_from_the_file_and_from_overrides() {
+        let text = format!(
+            "{BASE}\n[sensors]\nseed = 7\n[sensors.alpha]\nnoise_std = 1e-4\n\
+             [[faults.dropout]]\nfrom_s = 600\nuntil_s = 660.0\n\
+             [[faults.corrupt]]\nsensor = \"alpha_rate\"\nfrom_s = 10.0\nuntil_s = 11.0\nvalue = nan\n"
+        );
+        let sets = [
+            "faults.length_glitch=[{ at_s = 100, size_m = 100.0 }]".to_string(),
+            "reel.lag_s=2".to_string(),
+            "sensors.length.stuck_from_s=50".to_string(),
+        ];
+        let s = Scenario::from_toml_str(&text, FILE, &sets).unwrap();
+        assert_eq!(s.sensors.seed, 7);
+        assert_eq!(s.sensors.alpha.noise_std, 1e-4);
+        assert_eq!(
+            s.faults.dropout,
+            [WindowSection {
+                from_s: 600.0,
+                until_s: 660.0
+            }]
+        );
+        assert_eq!(s.faults.corrupt[0].sensor, SensorName::AlphaRate);
+        assert!(s.faults.corrupt[0].value.is_nan());
+        assert_eq!(
+            s.faults.length_glitch,
+            [GlitchSection {
+                at_s: 100.0,
+                size_m: 100.0
+            }]
+        );
+        assert_eq!(s.reel.lag_s, 2.0);
+        assert_eq!(s.sensors.length.stuck_from_s, 50.0);
+        assert_eq!(s.sensors.length.stuck_until_s, f64::INFINITY);
+        // The resolved scenario (as `run` writes it) reads back the same.
+        let again = toml::to_string_pretty(&s).unwrap();
+        let back = Scenario::from_toml_str(&again, FILE, &[]).unwrap();
+        assert_eq!(back.faults.dropout, s.faults.dropout);
+        assert_eq!(back.reel, s.reel);
+    }
+
+    #[test]
+    fn fault_keys_are_checked_like_every_other_key() {
+        let e = err(&["faults.dropout.from_s=3"]);
+        assert!(
+            e.contains("array of tables") && e.contains("from_s, until_s"),
+            "{e}"
+        );
+        let e = err(&["faults.dropout=3"]);
+        assert!(
+            e.contains("faults.dropout = 3 must be an array of tables"),
+            "{e}"
+        );
+        let e = err(&["faults.dropout=[{ from_s = 1, until = 2 }]"]);
+        assert!(e.contains("unknown key `faults.dropout.until`"), "{e}");
+        let e =
+            err(&["faults.corrupt=[{ sensor = \"beta\", from_s = 1, until_s = 2, value = 0 }]"]);
+        assert!(
+            e.contains("must be one of length, alpha, alpha_rate, orbit_rate"),
+            "{e}"
+        );
+        let e = err(&["sensors.alpha.noise=1"]);
+        assert!(
+            e.contains("unknown key `sensors.alpha.noise`") && e.contains("noise_std"),
+            "{e}"
+        );
+        let text = format!("{BASE}\n[faults.dropout]\nfrom_s = 1\nuntil_s = 2\n");
+        let e = Scenario::from_toml_str(&text, FILE, &[])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("faults.dropout = ") && e.contains("array of tables"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -1489,6 +2031,23 @@ max_length_m = 40_000.0
             (&["simulation.substeps=0"], "simulation.substeps", "0", "must be at least 1"),
             (&["simulation.output_interval_s=0"], "simulation.output_interval_s", "0", "must be above 0"),
             (&["simulation.output_interval_s=2.5"], "simulation.output_interval_s", "2.5", "positive whole multiple of controller.period_s = 1"),
+            (&["sensors.length.noise_std=-1"], "sensors.length.noise_std", "-1", "must not be negative"),
+            (&["sensors.alpha.bias=nan"], "sensors.alpha.bias", "NaN", "finite"),
+            (&["sensors.alpha_rate.quantum=-1e-6"], "sensors.alpha_rate.quantum", "-0.000001", "must not be negative"),
+            (&["sensors.alpha.stuck_from_s=-5"], "sensors.alpha.stuck_from_s", "-5", "must not be negative"),
+            (&["sensors.alpha.stuck_from_s=50", "sensors.alpha.stuck_until_s=40"], "sensors.alpha.stuck_until_s", "40", "must be after sensors.alpha.stuck_from_s = 50"),
+            (&["faults.dropout=[{ from_s = 100, until_s = 100 }]"], "faults.dropout[0].until_s", "100", "must be after faults.dropout[0].from_s = 100"),
+            (&["faults.dropout=[{ from_s = inf, until_s = inf }]"], "faults.dropout[0].from_s", "inf", "finite"),
+            (&["faults.corrupt=[{ sensor = \"alpha\", from_s = 5, until_s = nan, value = 0 }]"], "faults.corrupt[0].until_s", "NaN", "must be a number"),
+            (&["faults.length_glitch=[{ at_s = -1, size_m = 100 }]"], "faults.length_glitch[0].at_s", "-1", "must not be negative"),
+            (&["faults.length_glitch=[{ at_s = 1, size_m = inf }]"], "faults.length_glitch[0].size_m", "inf", "finite"),
+            (&["reel.lag_s=-1"], "reel.lag_s", "-1", "must not be negative"),
+            (&["reel.max_rate_mps=0"], "reel.max_rate_mps", "0", "must be above 0 (inf = no limit)"),
+            (&["reel.max_accel_mps2=nan"], "reel.max_accel_mps2", "NaN", "must be above 0"),
+            (&["monitor.coast_ticks=0"], "monitor.coast_ticks", "0", "must be at least 1"),
+            (&["monitor.length_jump_m=0"], "monitor.length_jump_m", "0", "must be above 0"),
+            (&["monitor.max_orbit_rate_radps=-1"], "monitor.max_orbit_rate_radps", "-1", "must be above 0"),
+            (&["monitor.max_orbit_rate_radps=1e-6"], "monitor.max_orbit_rate_radps", "0.000001", "must be above monitor.min_orbit_rate_radps = 0.00001"),
         ];
         for (sets, field, value, message) in cases {
             let e = err(sets);
@@ -1501,7 +2060,8 @@ max_length_m = 40_000.0
                 line.contains(message),
                 "{sets:?}: {line:?} lacks {message:?}"
             );
-            if sets.iter().any(|s| s.starts_with(&format!("{field}="))) {
+            let base = field.split('[').next().unwrap_or(field);
+            if sets.iter().any(|s| s.starts_with(&format!("{base}="))) {
                 assert!(line.ends_with("(set by --set)"), "{line}");
             }
         }

@@ -1,11 +1,16 @@
 //! The closed loop: the `tss-reel` controller core (f32, exactly as on the target) flying the
 //! f64 plant of Eq. 5, synchronised on the control period.
 //!
-//! Each tick: the plant's state is sensed (rounded to f32), the controller steps, its rate
-//! command is held over the period (zero-order hold) while RK4 integrates the plant.
+//! Each tick: the plant's state is sensed (through the scenario's sensor errors and injected
+//! faults, `faults::Injector`, then rounded to f32), the controller steps (or, in a dropout,
+//! steps without a sample), its rate command is held over the period (zero-order hold) and
+//! drives the reel (`reel::Reel`: ideal by default, else lagging and saturating) while RK4
+//! integrates the plant. Every tick feeds the fault summary (`History::faults`).
 
+use crate::faults::{Injector, Sensed, SummaryBuilder, TickRecord, Truth};
 use crate::history::{History, PhaseLabel, Sample};
 use crate::plant::{ix, Plant, State};
+use crate::reel::{Reel, ReelSaturation};
 use crate::scenario::Scenario;
 use tss_reel::controller::{
     Config, ConfigError, Controller, Envelope, Input, MonitorConfig, Output, Phase, Stage1Config,
@@ -86,8 +91,24 @@ pub fn controller_config<T: Real>(sc: &Scenario) -> Result<Config<T>, SimError> 
             min_length_m: f(sc.envelope.min_length_m),
             max_length_m: f(sc.envelope.max_length_m),
         },
-        monitor: MonitorConfig::default_for_period(),
+        monitor: monitor_config(sc),
     })
+}
+
+/// The controller's sensor-monitor thresholds from `[monitor]`.
+pub fn monitor_config<T: Real>(sc: &Scenario) -> MonitorConfig<T> {
+    let m = &sc.monitor;
+    MonitorConfig {
+        coast_ticks: m.coast_ticks,
+        recovery_ticks: m.recovery_ticks,
+        length_jump_m: T::from_f64(m.length_jump_m),
+        alpha_jump_rad: T::from_f64(m.alpha_jump_rad),
+        stuck_ticks: m.stuck_ticks,
+        stuck_motion_rad: T::from_f64(m.stuck_motion_rad),
+        max_alpha_rate_radps: T::from_f64(m.max_alpha_rate_radps),
+        min_orbit_rate_radps: T::from_f64(m.min_orbit_rate_radps),
+        max_orbit_rate_radps: T::from_f64(m.max_orbit_rate_radps),
+    }
 }
 
 fn mass_model<T: Real>(sc: &Scenario) -> MassModel<T> {
@@ -109,7 +130,9 @@ pub fn plant(sc: &Scenario) -> Plant {
 /// `value_s` as a whole number of periods (to 1e-9 relative), or a [`SimError::Timing`].
 fn ticks(field: &'static str, value_s: f64, period_s: f64) -> Result<u32, SimError> {
     let n = (value_s / period_s).round();
-    let ok = n >= 0.0 && n <= f64::from(u32::MAX) && (n * period_s - value_s).abs() <= 1e-9 * value_s.abs().max(period_s);
+    let ok = n >= 0.0
+        && n <= f64::from(u32::MAX)
+        && (n * period_s - value_s).abs() <= 1e-9 * value_s.abs().max(period_s);
     if ok {
         Ok(n as u32)
     } else {
@@ -169,7 +192,12 @@ pub fn run_with<T: Real>(
     let mut ctl = Controller::new(cfg).map_err(SimError::Config)?;
     let plant = plant(sc);
     let total = ticks("simulation.duration_s", sc.simulation.duration_s, period)?;
-    let every = ticks("simulation.output_interval_s", sc.simulation.output_interval_s, period)?.max(1);
+    let every = ticks(
+        "simulation.output_interval_s",
+        sc.simulation.output_interval_s,
+        period,
+    )?
+    .max(1);
     let mut probes: Vec<(u32, f64)> = Vec::with_capacity(probe_times_s.len());
     for &t in probe_times_s {
         probes.push((ticks("probe time", t, period)?, t));
@@ -181,23 +209,56 @@ pub fn run_with<T: Real>(
     let mut history = History {
         samples: Vec::with_capacity((total / every) as usize + 2),
         probes: Vec::with_capacity(probes.len()),
+        ..History::default()
     };
+    let mut injector = Injector::new(sc);
+    let mut reel = Reel::new(&sc.reel, sc.initial.length_rate_mps);
+    let ideal_reel = reel.is_ideal();
+    let mut summary = SummaryBuilder::new(period, &sc.envelope);
     let mut next_probe = 0;
     for tick in 0..=total {
         let t_s = f64::from(tick) * period;
         if !x.iter().all(|v| v.is_finite()) {
             return Err(SimError::Diverged { t_s });
         }
-        let theta = x[ix::THETA];
-        let input = Input {
-            tick,
-            length_m: T::from_f64(x[ix::LENGTH]),
-            alpha_rad: T::from_f64(x[ix::ALPHA]),
-            alpha_rate_radps: T::from_f64(x[ix::ALPHA_RATE]),
-            orbit_rate_radps: T::from_f64(plant.orbit.true_anomaly_rate_radps(theta)),
+        let truth = Truth {
+            length_m: x[ix::LENGTH],
+            alpha_rad: x[ix::ALPHA],
+            alpha_rate_radps: x[ix::ALPHA_RATE],
+            orbit_rate_radps: plant.orbit.true_anomaly_rate_radps(x[ix::THETA]),
         };
-        let out = ctl.step(&input);
+        let sensed = injector.sense(tick, t_s, &truth);
+        let out = match sensed {
+            Sensed::Sample(r) => ctl.step(&Input {
+                tick,
+                length_m: T::from_f64(r.length_m),
+                alpha_rad: T::from_f64(r.alpha_rad),
+                alpha_rate_radps: T::from_f64(r.alpha_rate_radps),
+                orbit_rate_radps: T::from_f64(r.orbit_rate_radps),
+            }),
+            Sensed::Missing => ctl.step_missing(tick),
+        };
         let rate = out.rate_cmd_mps.to_f64();
+        // The tension of Eq. 5a at the start of the period: with the ideal reel l̈ is the
+        // commanded acceleration; with a real drive, its actual rate and acceleration.
+        let (tension_n, reel_sat) = if ideal_reel {
+            let accel = out.accel_cmd_mps2.to_f64();
+            (plant.tension_n(&x, rate, accel), ReelSaturation::default())
+        } else {
+            let (v, a) = (reel.rate_after(rate, 0.0), reel.accel_after(rate, 0.0));
+            (plant.tension_n(&x, v, a), reel.saturation(rate, period))
+        };
+        summary.record(
+            &TickRecord {
+                tick,
+                t_s,
+                length_m: x[ix::LENGTH],
+                tension_n,
+                missing: sensed == Sensed::Missing,
+                reel: reel_sat,
+            },
+            &out,
+        );
         while next_probe < probes.len() && probes[next_probe].0 <= tick {
             if probes[next_probe].0 == tick {
                 history.probes.push((probes[next_probe].1, x[ix::LENGTH]));
@@ -205,7 +266,7 @@ pub fn run_with<T: Real>(
             next_probe += 1;
         }
         if tick % every == 0 || tick == total {
-            history.samples.push(sample(&plant, &x, t_s, &out));
+            history.samples.push(sample(&x, t_s, tension_n, &out));
         }
         if tick % progress_every == 0 {
             progress(t_s);
@@ -213,14 +274,42 @@ pub fn run_with<T: Real>(
         if tick == total {
             break;
         }
-        for _ in 0..substeps {
-            x = plant.rk4_step(&x, rate, h);
+        if ideal_reel {
+            for _ in 0..substeps {
+                x = plant.rk4_step(&x, rate, h);
+            }
+        } else {
+            for k in 0..substeps {
+                x = rk4_with_reel(&plant, &x, &reel, rate, f64::from(k) * h, h);
+            }
+            reel.advance(rate, period);
         }
     }
+    history.faults = summary.finish();
     Ok(history)
 }
 
-fn sample<T: Real>(plant: &Plant, x: &State, t_s: f64, out: &Output<T>) -> Sample {
+/// One RK4 step of `h_s` seconds starting `t0_s` into the period, with the reel's rate v(t)
+/// under the held command (`reel` is the drive at the start of the period): each stage sees
+/// the rate at its own time, so l integrates v(t) (Simpson's rule) and Eq. 5b sees l̇ = v(t).
+fn rk4_with_reel(
+    plant: &Plant,
+    x: &State,
+    reel: &Reel,
+    command_mps: f64,
+    t0_s: f64,
+    h_s: f64,
+) -> State {
+    let v = |t: f64| reel.rate_after(command_mps, t);
+    let (v0, v1, v2) = (v(t0_s), v(t0_s + 0.5 * h_s), v(t0_s + h_s));
+    let k1 = plant.derivative(x, v0);
+    let k2 = plant.derivative(&(x + k1 * (0.5 * h_s)), v1);
+    let k3 = plant.derivative(&(x + k2 * (0.5 * h_s)), v1);
+    let k4 = plant.derivative(&(x + k3 * h_s), v2);
+    x + (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h_s / 6.0)
+}
+
+fn sample<T: Real>(x: &State, t_s: f64, tension_n: f64, out: &Output<T>) -> Sample {
     let rate = out.rate_cmd_mps.to_f64();
     let accel = out.accel_cmd_mps2.to_f64();
     Sample {
@@ -233,7 +322,7 @@ fn sample<T: Real>(plant: &Plant, x: &State, t_s: f64, out: &Output<T>) -> Sampl
         delta_rad: out.delta_rad.to_f64(),
         delta_rate_radps: out.delta_rate_radps.to_f64(),
         beta_rad: x[ix::BETA],
-        tension_n: plant.tension_n(x, rate, accel),
+        tension_n,
         length_accel_mps2: accel,
         law_rate_mps: out.law_rate_mps.to_f64(),
         blend_weight: out.blend_weight.to_f64(),

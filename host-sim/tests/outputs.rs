@@ -175,6 +175,7 @@ fn synthetic(n: usize) -> History {
             .iter()
             .map(|&t| (t, 30_000.0 + t * 1e-6))
             .collect(),
+        ..History::default()
     }
 }
 
