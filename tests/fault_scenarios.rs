@@ -273,9 +273,16 @@ fn alpha_bias_of_one_degree_converges_to_the_predicted_offset_keep() {
         "bias: δ_eq = {:.4}°, predicted stage-1 keep {keep1:.3} m",
         delta_eq.to_degrees()
     );
-    // Stage 1, Table-1 instants 7–8 h: within 1 m of the prediction (measured 0.2 m at 7 h).
+    // Stage 1, Table-1 instants 7–8 h: within 25 cm of the prediction.
+    let worst = h
+        .probes
+        .iter()
+        .filter(|p| p.0 <= 28_800.0)
+        .map(|p| (p.1 - keep1).abs())
+        .fold(0.0, f64::max);
+    eprintln!("bias: stage-1 keep within {worst:.4} m of the prediction");
     for &(t, l) in h.probes.iter().filter(|p| p.0 <= 28_800.0) {
-        assert!((l - keep1).abs() < 1.0, "t = {t} s: {l} m vs {keep1} m");
+        assert!((l - keep1).abs() < 0.25, "t = {t} s: {l} m vs {keep1} m"); // measured 5 cm
     }
     let s8 = at(&h, 28_790.0);
     assert!(s8.alpha_rad.abs() < 1e-3, "true α at 8 h: {}", s8.alpha_rad);
@@ -309,7 +316,7 @@ fn alpha_bias_of_one_degree_converges_to_the_predicted_offset_keep() {
     );
     assert_envelope(f, 0.0);
     // Slack only in the paper's near-zero-tension passage (l ≈ 26 m, t ≈ 1000 s; the clean
-    // mission's minimum there is 3.3e-5 N): measured one episode 1045–1463 s.
+    // mission's minimum there is 3.3e-5 N): measured one episode 866–1284 s.
     assert!(
         f.slack_episodes.iter().all(|e| e.1 <= 1_800.0),
         "{:?}",
@@ -402,6 +409,7 @@ fn one_tick_length_glitch_is_rejected_without_effect() {
         .zip(&clean_stage1().samples)
         .map(|(a, b)| (a.length_m - b.length_m).abs())
         .fold(0.0, f64::max);
+    eprintln!("glitch: largest length difference {worst:.6} m");
     assert!(worst < 1e-3, "largest length difference {worst} m");
 }
 
@@ -409,7 +417,7 @@ fn one_tick_length_glitch_is_rejected_without_effect() {
 /// whose drive is itself limited to 0.1 m/s²: the controller's rate and acceleration limits
 /// act and are counted, the drive saturates too, the lag never trips the length monitor, the
 /// tether stays inside [l_min, l_max], and it is never slack after the paper's near-zero-tension
-/// passage of early deployment (measured: one episode, 1112–1397 s at l ≈ 26 m).
+/// passage of early deployment (measured: one episode, 983–1268 s at l ≈ 26 m).
 #[test]
 fn lagging_saturating_reel_counts_saturation_and_keeps_the_envelope() {
     let h = run(REEL_LIMITS, &["reel.lag_s=2", "reel.max_accel_mps2=0.1"]);
@@ -438,18 +446,19 @@ fn lagging_saturating_reel_counts_saturation_and_keeps_the_envelope() {
         "{:?}",
         f.slack_episodes
     );
-    // Lengths: the keeps are still held (Table 1 within 0.5 m of the ideal reel's).
+    // Lengths: the keeps are still held (Table 1 within 5 cm of the ideal reel's; measured
+    // 2.5 mm).
     let d = probe_difference(&h, &run(REEL_LIMITS, &[]));
     eprintln!("lag: Table-1 difference from the ideal reel {d:.4} m");
-    assert!(d < 0.5, "{d}");
+    assert!(d < 0.05, "{d}");
 }
 
 /// HZ-7, open: a 2 s lag with no acceleration limit of its own. Following the controller's
 /// staircase of 0.1 m/s steps, the drive's instantaneous acceleration peaks at
 /// 0.1/(1 − e^{−1/2}) ≈ 0.25 m/s ÷ 2 s ≈ 0.127 m/s² right after each step; when the slew
 /// ends (t ≈ 29 300 s) the controller brakes the wind-in at its 0.1 m/s² limit with only
-/// 10.7 N − 99 kg × 0.1 m/s² ≈ 0.8 N of tension to spare, so the tether goes slack for 90 s
-/// (min −1.93 N). The envelope does not bound the physical acceleration of a lagging drive.
+/// 10.7 N − 99 kg × 0.1 m/s² ≈ 0.8 N of tension to spare, so the tether goes slack for 89 s
+/// (29 303–29 392 s, min −1.93 N). The envelope does not bound the physical acceleration of a lagging drive.
 #[test]
 #[ignore = "open hazard (core): a lagging reel without its own acceleration limit slackens the tether at the stage-2 braking (min -1.93 N, 2 episodes, 374 s)"]
 fn lagging_reel_without_drive_limit_stays_taut_after_early_deployment() {
@@ -615,4 +624,75 @@ fn the_fault_summary_text_reports_faults_and_slack() {
     ] {
         assert!(text.contains(needle), "{needle:?} not in:\n{text}");
     }
+}
+
+/// HZ-9 (SEDS-1: a large swing). The sub-satellite is released swinging backward at
+/// δ̇(0) = −1.2e-3 rad/s, faster than the orbit rate (n ≈ 1.06e-3 rad/s), so Eq. 27's
+/// denominator n + δ̇ is negative: the law reports SingularDenominator, the reel coasts on
+/// l̇0 (Degraded, 29 s, below the 30 s coast), the law takes over as the swing slows, and the
+/// deployment reaches its keep (measured: 3.307 h, 103 s later than nominal). The command is
+/// flagged NO_EQUILIBRIUM while outside the Eq. 13 region.
+#[test]
+fn large_initial_swing_hits_the_law_singularity_coasts_and_recovers() {
+    let h = run(
+        REEL_LIMITS,
+        &[
+            "initial.delta_rate_radps=-1.2e-3",
+            "simulation.duration_s=14400",
+        ],
+    );
+    let f = &h.faults;
+    let singular = Fault::Law(tss_reel::law::LawFault::SingularDenominator);
+    let t = f.tally(singular).expect("SingularDenominator raised");
+    assert_eq!((t.first_s, t.ticks), (0.0, 29));
+    assert_eq!(
+        transitions(f),
+        [
+            (0.0, Health::Nominal, Health::Degraded),
+            (29.0, Health::Degraded, Health::Nominal),
+        ]
+    );
+    assert_eq!(f.safe_hold_s, 0.0);
+    assert!(at(&h, 0.0).flags & Flags::NO_EQUILIBRIUM != 0);
+    let keep = h
+        .samples
+        .iter()
+        .find(|s| s.phase == PhaseLabel::Keep1)
+        .expect("keep reached");
+    assert!(keep.t_s < 12_500.0, "keep at {} s", keep.t_s);
+    assert_envelope(f, 0.0);
+}
+
+/// `scenarios/faults-demo.toml` (the shipped demonstration): every injected fault is raised
+/// with its own type, each is coasted through or held and recovered from, and the mission
+/// still ends at the 2 km keep inside the envelope.
+#[test]
+fn the_fault_demo_raises_every_fault_and_still_completes_the_mission() {
+    let h = run("scenarios/faults-demo.toml", &[]);
+    let f = &h.faults;
+    for s in [
+        Sensor::AlphaStuck,
+        Sensor::Alpha,
+        Sensor::Missing,
+        Sensor::LengthJump,
+        Sensor::OrbitRate,
+    ] {
+        assert!(
+            f.raised(Fault::Sensor(s)),
+            "{s:?} not raised: {:?}",
+            f.faults
+        );
+    }
+    assert_eq!(f.faults.len(), 5, "{:?}", f.faults);
+    assert_eq!(ticks_of(f, Fault::Sensor(Sensor::Missing)), 80);
+    assert_eq!(f.final_health, Some(Health::Nominal));
+    assert!(f.safe_hold_s > 0.0);
+    assert_envelope(f, 0.0);
+    let last = h.samples.last().unwrap();
+    assert_eq!(last.phase, PhaseLabel::Keep2);
+    assert!(
+        (last.length_m - 2000.0).abs() < 0.1,
+        "final l {}",
+        last.length_m
+    );
 }
