@@ -15,6 +15,7 @@ pub mod equilibrium;
 pub mod fastmath;
 pub mod hal;
 pub mod law;
+pub mod link;
 pub mod mass;
 pub mod monitor;
 pub mod orbit;
