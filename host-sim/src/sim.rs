@@ -38,6 +38,9 @@ pub enum SimError {
         /// The control period, s.
         period_s: f64,
     },
+    /// The controller in the loop failed (the processor-in-the-loop link, `crate::pil`).
+    #[error("the processor-in-the-loop link failed")]
+    Link(#[source] Box<dyn std::error::Error + Send + Sync>),
     /// The plant state stopped being finite (a physically impossible run).
     #[error("the plant state became non-finite at t = {t_s} s")]
     Diverged {
@@ -186,10 +189,37 @@ pub fn run_with<T: Real>(
     probe_times_s: &[f64],
     progress: &mut dyn FnMut(f64),
 ) -> Result<History, SimError> {
+    let mut ctl = Controller::new(controller_config::<T>(sc)?).map_err(SimError::Config)?;
+    run_stepper(sc, &mut ctl, probe_times_s, progress)
+}
+
+/// The controller in the loop, one control period at a time: the core linked into the
+/// simulator ([`Controller`]) or the flight firmware in QEMU over the processor-in-the-loop
+/// link (`crate::pil`).
+pub trait Stepper<T> {
+    /// One control period: `input` is the sensed sample, `None` when none arrived (a dropout).
+    fn step(&mut self, tick: u32, input: Option<&Input<T>>) -> Result<Output<T>, SimError>;
+}
+
+impl<T: Real> Stepper<T> for Controller<T> {
+    fn step(&mut self, tick: u32, input: Option<&Input<T>>) -> Result<Output<T>, SimError> {
+        Ok(match input {
+            Some(x) => Controller::step(self, x),
+            None => self.step_missing(tick),
+        })
+    }
+}
+
+/// Runs the scenario with `stepper` as the controller: the plant loop of [`run_with`].
+pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
+    sc: &Scenario,
+    stepper: &mut S,
+    probe_times_s: &[f64],
+    progress: &mut dyn FnMut(f64),
+) -> Result<History, SimError> {
     let period = sc.controller.period_s;
     let cfg = controller_config::<T>(sc)?;
     let mut x = initial_state(sc, &cfg);
-    let mut ctl = Controller::new(cfg).map_err(SimError::Config)?;
     let plant = plant(sc);
     let total = ticks("simulation.duration_s", sc.simulation.duration_s, period)?;
     let every = ticks(
@@ -229,14 +259,17 @@ pub fn run_with<T: Real>(
         };
         let sensed = injector.sense(tick, t_s, &truth);
         let out = match sensed {
-            Sensed::Sample(r) => ctl.step(&Input {
+            Sensed::Sample(r) => stepper.step(
                 tick,
-                length_m: T::from_f64(r.length_m),
-                alpha_rad: T::from_f64(r.alpha_rad),
-                alpha_rate_radps: T::from_f64(r.alpha_rate_radps),
-                orbit_rate_radps: T::from_f64(r.orbit_rate_radps),
-            }),
-            Sensed::Missing => ctl.step_missing(tick),
+                Some(&Input {
+                    tick,
+                    length_m: T::from_f64(r.length_m),
+                    alpha_rad: T::from_f64(r.alpha_rad),
+                    alpha_rate_radps: T::from_f64(r.alpha_rate_radps),
+                    orbit_rate_radps: T::from_f64(r.orbit_rate_radps),
+                }),
+            )?,
+            Sensed::Missing => stepper.step(tick, None)?,
         };
         let rate = out.rate_cmd_mps.to_f64();
         // The tension of Eq. 5a at the start of the period: with the ideal reel l̈ is the
