@@ -630,7 +630,7 @@ fn the_fault_summary_text_reports_faults_and_slack() {
 /// δ̇(0) = −1.2e-3 rad/s, faster than the orbit rate (n ≈ 1.06e-3 rad/s), so Eq. 27's
 /// denominator n + δ̇ is negative: the law reports SingularDenominator, the reel coasts on
 /// l̇0 (Degraded, 29 s, below the 30 s coast), the law takes over as the swing slows, and the
-/// deployment reaches its keep (measured: 3.307 h, 103 s later than nominal). The command is
+/// deployment reaches its keep (measured: 3.307 h, 104 s later than nominal). The command is
 /// flagged NO_EQUILIBRIUM while outside the Eq. 13 region.
 #[test]
 fn large_initial_swing_hits_the_law_singularity_coasts_and_recovers() {
