@@ -3,11 +3,26 @@
 //!
 //! Limits apply in this order: speed, then acceleration (the change from the previous command),
 //! then the length limits, which win over the acceleration limit when they must. Near a length
-//! limit the allowed speed toward it follows the braking curve v ≤ √(2 a d) (d: distance left,
-//! a: acceleration limit), so the reel can stop within its acceleration limit; it is also held
-//! to d/dt so that one period cannot carry the tether past the limit.
+//! limit the allowed speed toward it follows the *discrete* braking curve of a staircase of
+//! decrements a·Δt (a: acceleration limit, Δt: the period, d: distance left). Stepping down from
+//! v ∈ [m aΔt, (m+1) aΔt) to zero covers D(v) = Δt[(m+1) v − aΔt m(m+1)/2]; the largest v with
+//! D(v) ≤ d is
+//!
+//! ```text
+//!   m = ⌊√(1/4 + 2d/(aΔt²)) − 1/2⌋,      v = (d/Δt + aΔt m(m+1)/2) / (m+1),
+//! ```
+//!
+//! and after one period at that speed the bound is exactly v − aΔt: the reel stops at the limit
+//! without ever exceeding its acceleration limit (the continuous √(2ad), evaluated once a
+//! period, would ask for up to 1.8 a). The distance
+//! is measured to the limit less a guard of [`LENGTH_GUARD_REL`] × the limit, which covers the
+//! f32 rounding of the sensed length.
 
 use crate::real::Real;
+
+/// Guard kept from each length limit, relative to the limit (≈ one f32 ulp: 3.6 mm at 30 km),
+/// so that the rounding of an f32 length cannot leave the tether resting just past it.
+pub const LENGTH_GUARD_REL: f64 = 1.2e-7;
 
 /// Rate, acceleration and length limits of the reel.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -62,16 +77,39 @@ impl<T: Real> Envelope<T> {
             sat.accel = true;
             y = y.clamp_to(previous_mps - dv, previous_mps + dv);
         }
-        let two = T::from_f64(2.0);
-        let up_room = (self.max_length_m - length_m).max(T::ZERO);
-        let down_room = (length_m - self.min_length_m).max(T::ZERO);
-        let up = (up_room / dt_s).min((two * self.max_accel_mps2 * up_room).sqrt());
-        let down = -(down_room / dt_s).min((two * self.max_accel_mps2 * down_room).sqrt());
+        let guard = T::from_f64(LENGTH_GUARD_REL);
+        let up_room = (self.max_length_m * (T::ONE - guard) - length_m).max(T::ZERO);
+        let down_room = (length_m - self.min_length_m * (T::ONE + guard)).max(T::ZERO);
+        let up = self.braking_speed(up_room, dt_s);
+        let down = -self.braking_speed(down_room, dt_s);
         if y > up || y < down {
             sat.length = true;
             y = y.clamp_to(down, up);
+            // The braking curve keeps the acceleration limit in exact arithmetic; the f32
+            // rounding of the sensed length (≈ 1 mm at 30 km) can make it ask for a hair more.
+            // Travel within the guard is allowed for that, so the acceleration limit holds and
+            // the limit itself (beyond the guard) is still never passed.
+            let guard_m = self.max_length_m * guard;
+            let (lo, hi) = (previous_mps - dv, previous_mps + dv);
+            if y < lo && (lo - y) * dt_s <= guard_m {
+                y = lo;
+            } else if y > hi && (y - hi) * dt_s <= guard_m {
+                y = hi;
+            }
         }
         (y.clamp_to(-vmax, vmax), sat)
+    }
+
+    /// The largest speed toward a limit `room_m` away from which the reel can still stop at
+    /// it, decelerating by at most a·Δt per period (see the module docs).
+    fn braking_speed(&self, room_m: T, dt_s: T) -> T {
+        let half = T::from_f64(0.5);
+        let dv = self.max_accel_mps2 * dt_s;
+        let m = ((T::from_f64(0.25) + T::from_f64(2.0) * room_m / (dv * dt_s)).sqrt() - half)
+            .max(T::ZERO)
+            .floor();
+        // Rounding can leave v a hair above (m+1)·aΔt; the next m covers it.
+        (room_m / dt_s + dv * m * (m + T::ONE) * half) / (m + T::ONE)
     }
 }
 
@@ -107,9 +145,14 @@ mod tests {
 
     #[test]
     fn braking_curve_near_the_spool_end() {
-        // 50 m left at 0.1 m/s²: at most √(2·0.1·50) = √10 m/s toward the limit.
+        // 50 m left (less the guard) at 0.1 m/s², 1 s: 0.1 (√(1/4 + 2·d/0.1) − 1/2) m/s.
+        // m = ⌊√(1/4 + 2d/0.1) − 1/2⌋ = 31, v = (d + 0.1·31·32/2)/32.
+        let d = 40_000.0 * (1.0 - LENGTH_GUARD_REL) - 39_950.0;
         let (y, s) = env().limit(5.0, 5.0, 39_950.0, 1.0);
-        assert!((y - 10f64.sqrt()).abs() < 1e-12 && s.length);
+        let m = ((0.25 + 2.0 * d / 0.1_f64).sqrt() - 0.5).floor();
+        assert_eq!(m, 31.0);
+        let expect = (d + 0.1 * m * (m + 1.0) / 2.0) / (m + 1.0);
+        assert!((y - expect).abs() < 1e-12 && s.length, "{y} vs {expect}");
         // At the limit nothing more goes out, but winding in is allowed.
         assert_eq!(env().limit(1.0, 0.0, 40_000.0, 1.0).0, 0.0);
         assert_eq!(env().limit(-0.05, 0.0, 40_000.0, 1.0).0, -0.05);
@@ -121,6 +164,25 @@ mod tests {
         assert!(
             s.length && y >= -0.1 - 1e-12 && 0.6 + y >= 0.5 - 1e-12,
             "{y}"
+        );
+    }
+
+    #[test]
+    fn braking_to_a_limit_never_exceeds_the_acceleration_limit() {
+        // From full speed 500 m before the spool end, the reel follows the curve down to rest
+        // at the limit with every decrement within a·Δt.
+        let e = env();
+        let (mut l, mut v) = (39_500.0_f64, 10.0_f64);
+        for _ in 0..2_000 {
+            let (y, _) = e.limit(10.0, v, l, 1.0);
+            assert!((y - v).abs() <= 0.1 * (1.0 + 1e-9), "{v} -> {y} at {l}");
+            v = y;
+            l += v;
+            assert!(l <= 40_000.0, "past the spool end: {l}");
+        }
+        assert!(
+            v.abs() < 1e-9 && 40_000.0 - l < 0.1,
+            "stopped at {l} with {v}"
         );
     }
 

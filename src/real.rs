@@ -47,6 +47,8 @@ pub trait Real:
     }
     /// Absolute value.
     fn abs(self) -> Self;
+    /// The largest integer not above `self`.
+    fn floor(self) -> Self;
     /// Four-quadrant arctangent of `self / x`.
     fn atan2(self, x: Self) -> Self;
     /// Arcsine (NaN outside [-1, 1]).
@@ -134,6 +136,10 @@ impl Real for f32 {
         libm::fabsf(self)
     }
     #[inline]
+    fn floor(self) -> Self {
+        libm::floorf(self)
+    }
+    #[inline]
     fn atan2(self, x: Self) -> Self {
         libm::atan2f(self, x)
     }
@@ -181,6 +187,10 @@ impl Real for f64 {
     #[inline]
     fn abs(self) -> Self {
         libm::fabs(self)
+    }
+    #[inline]
+    fn floor(self) -> Self {
+        libm::floor(self)
     }
     #[inline]
     fn atan2(self, x: Self) -> Self {
