@@ -6,7 +6,7 @@
 //! the tension the reel must hold.
 
 use nalgebra::SVector;
-use tss_reel::mass::MassModel;
+use tss_reel::mass::{MassCoefficients, MassModel};
 use tss_reel::orbit::Orbit;
 
 /// Plant state: θ (true anomaly), l, α, α̇, β, β̇ (rad, m, rad/s).
@@ -37,19 +37,80 @@ pub struct Plant {
     pub masses: MassModel<f64>,
 }
 
+/// What one RK4 step evaluates over and over and that does not depend on the state it is
+/// evaluated at: the orbit's θ̇, θ̈ and μ/R³ on a circular orbit (uniform there: θ̇ = n,
+/// θ̈ = 0, R = a), and the mass coefficients of a massless tether (ρ = 0: independent of l).
+/// The values are computed by the same expressions as the general case, so a step is
+/// bit-for-bit the same with or without them (see the tests).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Frozen {
+    /// (θ̇, μ/R³) on a circular orbit (θ̈ = 0 there).
+    circular: Option<(f64, f64)>,
+    /// The mass coefficients of a massless tether.
+    massless: Option<MassCoefficients<f64>>,
+}
+
 impl Plant {
+    /// The state-independent quantities of this plant (see [`Frozen`]).
+    fn frozen(&self) -> Frozen {
+        let circular = (self.orbit.eccentricity == 0.0).then(|| {
+            // θ̇ = n(1 + e cos θ)²/(1 − e²)^{3/2} = n and R = a(1 − e²)/(1 + e cos θ) = a
+            // exactly when e = 0 (the general expressions multiply and divide by 1).
+            let a = self.orbit.semi_major_axis_m;
+            (
+                self.orbit.mean_motion_radps(),
+                self.orbit.mu_m3ps2 / (a * a * a),
+            )
+        });
+        let massless =
+            (self.masses.tether_density_kg_per_m == 0.0).then(|| self.masses.coefficients(1.0));
+        Frozen { circular, massless }
+    }
+
+    /// θ̇, θ̈ and μ/R³ at true anomaly θ.
+    #[inline]
+    fn orbit_terms(&self, f: &Frozen, theta: f64) -> (f64, f64, f64) {
+        match f.circular {
+            Some((theta_rate, gg)) => (theta_rate, 0.0, gg),
+            None => (
+                self.orbit.true_anomaly_rate_radps(theta),
+                self.orbit.true_anomaly_accel_radps2(theta),
+                self.orbit.gravity_gradient_per_s2(theta), // μ/R³
+            ),
+        }
+    }
+
+    /// The mass coefficients at length `l`.
+    #[inline]
+    fn mass_terms(&self, f: &Frozen, l: f64) -> MassCoefficients<f64> {
+        match f.massless {
+            Some(c) => c,
+            None => self.masses.coefficients(l),
+        }
+    }
+
     /// Time derivative of the state with the reel running at `rate_mps` (Eqs. 5b, 5c).
     pub fn derivative(&self, x: &State, rate_mps: f64) -> State {
+        self.derivative_with(&self.frozen(), x, rate_mps)
+    }
+
+    /// [`Plant::derivative`] with the state-independent quantities already evaluated.
+    #[inline]
+    fn derivative_with(&self, f: &Frozen, x: &State, rate_mps: f64) -> State {
         let theta = x[ix::THETA];
         let l = x[ix::LENGTH];
         let (alpha, alpha_rate) = (x[ix::ALPHA], x[ix::ALPHA_RATE]);
         let (beta, beta_rate) = (x[ix::BETA], x[ix::BETA_RATE]);
-        let theta_rate = self.orbit.true_anomaly_rate_radps(theta);
-        let theta_accel = self.orbit.true_anomaly_accel_radps2(theta);
-        let gg = self.orbit.gravity_gradient_per_s2(theta); // μ/R³
-        let mu3 = self.masses.coefficients(l).mu3;
+        let (theta_rate, theta_accel, gg) = self.orbit_terms(f, theta);
+        let mu3 = self.mass_terms(f, l).mu3;
         let spin = theta_rate + alpha_rate;
         let stretch = (2.0 + mu3) * rate_mps / l;
+        if beta == 0.0 && beta_rate == 0.0 {
+            // In the orbit plane (β = β̇ = 0, which Eq. 5c keeps): tan β = sin 2β = 0, so the
+            // β terms vanish and β̈ = 0.
+            let alpha_accel = -spin * stretch - 1.5 * gg * (2.0 * alpha).sin() - theta_accel;
+            return State::from([theta_rate, rate_mps, alpha_rate, alpha_accel, 0.0, 0.0]);
+        }
         // Eq. 5b
         let alpha_accel = -spin * (stretch - 2.0 * beta_rate * beta.tan())
             - 1.5 * gg * (2.0 * alpha).sin()
@@ -58,15 +119,23 @@ impl Plant {
         let beta_accel = -stretch * beta_rate
             - 0.5 * spin * spin * (2.0 * beta).sin()
             - 1.5 * gg * alpha.cos().powi(2) * (2.0 * beta).sin();
-        State::from([theta_rate, rate_mps, alpha_rate, alpha_accel, beta_rate, beta_accel])
+        State::from([
+            theta_rate,
+            rate_mps,
+            alpha_rate,
+            alpha_accel,
+            beta_rate,
+            beta_accel,
+        ])
     }
 
     /// One classical RK4 step of `h_s` seconds with the reel rate held at `rate_mps`.
     pub fn rk4_step(&self, x: &State, rate_mps: f64, h_s: f64) -> State {
-        let k1 = self.derivative(x, rate_mps);
-        let k2 = self.derivative(&(x + k1 * (0.5 * h_s)), rate_mps);
-        let k3 = self.derivative(&(x + k2 * (0.5 * h_s)), rate_mps);
-        let k4 = self.derivative(&(x + k3 * h_s), rate_mps);
+        let f = self.frozen();
+        let k1 = self.derivative_with(&f, x, rate_mps);
+        let k2 = self.derivative_with(&f, &(x + k1 * (0.5 * h_s)), rate_mps);
+        let k3 = self.derivative_with(&f, &(x + k2 * (0.5 * h_s)), rate_mps);
+        let k4 = self.derivative_with(&f, &(x + k3 * h_s), rate_mps);
         x + (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h_s / 6.0)
     }
 
@@ -74,12 +143,14 @@ impl Plant {
     /// T_t = m_r[−l̈ − μ1 l̇²/l + μ2 l(β̇² + (θ̇+α̇)² cos²β + (μ/R³)(3cos²α cos²β − 1))].
     /// A value ≤ 0 means a slack tether.
     pub fn tension_n(&self, x: &State, rate_mps: f64, accel_mps2: f64) -> f64 {
+        let f = self.frozen();
         let theta = x[ix::THETA];
         let l = x[ix::LENGTH];
-        let c = self.masses.coefficients(l);
-        let spin = self.orbit.true_anomaly_rate_radps(theta) + x[ix::ALPHA_RATE];
-        let gg = self.orbit.gravity_gradient_per_s2(theta);
-        let cb2 = x[ix::BETA].cos().powi(2);
+        let c = self.mass_terms(&f, l);
+        let (theta_rate, _, gg) = self.orbit_terms(&f, theta);
+        let spin = theta_rate + x[ix::ALPHA_RATE];
+        let beta = x[ix::BETA];
+        let cb2 = if beta == 0.0 { 1.0 } else { beta.cos().powi(2) };
         let ca2 = x[ix::ALPHA].cos().powi(2);
         let field = x[ix::BETA_RATE].powi(2) + spin * spin * cb2 + gg * (3.0 * ca2 * cb2 - 1.0);
         c.radial_kg * (-accel_mps2 - c.mu1 * rate_mps * rate_mps / l + c.mu2 * l * field)
@@ -94,6 +165,100 @@ mod tests {
         Plant {
             orbit: Orbit::circular(7_078_000.0),
             masses: MassModel::paper(),
+        }
+    }
+
+    /// Eqs. 5b–5c as written, with every term evaluated (the reference for the shortcuts).
+    fn reference_derivative(p: &Plant, x: &State, rate_mps: f64) -> State {
+        let (theta, l, alpha, alpha_rate, beta, beta_rate) = (x[0], x[1], x[2], x[3], x[4], x[5]);
+        let theta_rate = p.orbit.true_anomaly_rate_radps(theta);
+        let theta_accel = p.orbit.true_anomaly_accel_radps2(theta);
+        let gg = p.orbit.gravity_gradient_per_s2(theta);
+        let mu3 = p.masses.coefficients(l).mu3;
+        let spin = theta_rate + alpha_rate;
+        let stretch = (2.0 + mu3) * rate_mps / l;
+        let alpha_accel = -spin * (stretch - 2.0 * beta_rate * beta.tan())
+            - 1.5 * gg * (2.0 * alpha).sin()
+            - theta_accel;
+        let beta_accel = -stretch * beta_rate
+            - 0.5 * spin * spin * (2.0 * beta).sin()
+            - 1.5 * gg * alpha.cos().powi(2) * (2.0 * beta).sin();
+        State::from([
+            theta_rate,
+            rate_mps,
+            alpha_rate,
+            alpha_accel,
+            beta_rate,
+            beta_accel,
+        ])
+    }
+
+    /// Eq. 5a as written (the reference for the shortcuts).
+    fn reference_tension(p: &Plant, x: &State, rate: f64, accel: f64) -> f64 {
+        let (theta, l) = (x[ix::THETA], x[ix::LENGTH]);
+        let c = p.masses.coefficients(l);
+        let spin = p.orbit.true_anomaly_rate_radps(theta) + x[ix::ALPHA_RATE];
+        let gg = p.orbit.gravity_gradient_per_s2(theta);
+        let (cb2, ca2) = (x[ix::BETA].cos().powi(2), x[ix::ALPHA].cos().powi(2));
+        let field = x[ix::BETA_RATE].powi(2) + spin * spin * cb2 + gg * (3.0 * ca2 * cb2 - 1.0);
+        c.radial_kg * (-accel - c.mu1 * rate * rate / l + c.mu2 * l * field)
+    }
+
+    /// The shortcuts of [`Frozen`] (circular orbit, massless tether) and of the in-plane state
+    /// give the equations' results bit for bit.
+    #[test]
+    fn shortcuts_are_bit_identical_to_the_equations() {
+        for (ecc, rho) in [(0.0, 0.0), (0.0, 1e-3), (0.01, 0.0), (0.01, 1e-3)] {
+            let p = Plant {
+                orbit: Orbit::elliptic(7_078_000.0, ecc),
+                masses: MassModel {
+                    tether_density_kg_per_m: rho,
+                    ..MassModel::paper()
+                },
+            };
+            let f = p.frozen();
+            assert_eq!(f.circular.is_some(), ecc == 0.0);
+            assert_eq!(f.massless.is_some(), rho == 0.0);
+            for (i, beta, beta_rate) in [
+                (0_u32, 0.0, 0.0),
+                (1, 0.0, 1e-4),
+                (2, 0.03, 0.0),
+                (3, -0.2, -1e-4),
+            ] {
+                let th = 1.3 + 17.0 * f64::from(i);
+                let x = State::from([th, 12_345.6, -0.61, 2e-3, beta, beta_rate]);
+                for rate in [0.0, 3.2, -7.5] {
+                    let fast = p.derivative(&x, rate);
+                    let slow = reference_derivative(&p, &x, rate);
+                    // Equal as numbers: in the plane the equations give β̈ = −0.0 where the
+                    // shortcut gives +0.0, which no sum of the step can tell apart (0 + −0 = 0).
+                    for k in 0..6 {
+                        assert!(
+                            fast[k] == slow[k],
+                            "{ecc} {rho} {x} {k}: {} {}",
+                            fast[k],
+                            slow[k]
+                        );
+                    }
+                    let step = p.rk4_step(&x, rate, 1.0);
+                    let h = 1.0;
+                    let k1 = slow;
+                    let k2 = reference_derivative(&p, &(x + k1 * (0.5 * h)), rate);
+                    let k3 = reference_derivative(&p, &(x + k2 * (0.5 * h)), rate);
+                    let k4 = reference_derivative(&p, &(x + k3 * h), rate);
+                    let expect = x + (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h / 6.0);
+                    for k in 0..6 {
+                        assert_eq!(
+                            step[k].to_bits(),
+                            expect[k].to_bits(),
+                            "{ecc} {rho} {x} {k}"
+                        );
+                    }
+                    let t = p.tension_n(&x, rate, 0.01);
+                    let expect = reference_tension(&p, &x, rate, 0.01);
+                    assert_eq!(t.to_bits(), expect.to_bits(), "{ecc} {rho} {x}");
+                }
+            }
         }
     }
 
