@@ -10,6 +10,8 @@
 //! - [`firmware::exit`]: how a run ends (semihosting exit, HardFault and default handlers);
 //! - [`firmware::mission`]: what is done on each tick: **the part to replace** with the real
 //!   controller; this loop does not change when it is.
+//! - [`firmware::pil`]: the processor-in-the-loop mission over UART0 ([`firmware::uart`]),
+//!   selected by `pil` on the semihosting command line ([`firmware::cmdline`]; QEMU `-append pil`).
 //!
 //! In QEMU one SysTick interrupt is one control period of mission time, and the idle time between
 //! ticks is skipped (`-icount …,sleep=off` in `scripts/qemu-run`): mission time is accelerated and
@@ -20,7 +22,9 @@
 //! workspace's `[[bin]]` entries.
 #![cfg_attr(target_os = "none", no_std, no_main)]
 // `unsafe` is allowed only where cortex-m-rt demands it: the `unsafe fn` signatures of the
-// HardFault and default handlers (src/firmware/exit.rs), each with an `#[allow]` that says so.
+// HardFault and default handlers (src/firmware/exit.rs), each with an `#[allow]` that says so;
+// and where hardware demands it: the UART's volatile register access (src/firmware/uart.rs) and
+// the semihosting command-line call (src/firmware/cmdline.rs), each with a SAFETY comment.
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -51,6 +55,10 @@ fn main() -> ! {
         exit::failure();
     };
     let mut clock = ControlClock::start(core.SYST, mission::CONTROL_PERIOD_MS);
+    // `-append pil`: processor-in-the-loop over UART0 instead of the built-in replay.
+    if firmware::cmdline::mode() == firmware::cmdline::Mode::Pil {
+        firmware::pil::run(clock);
+    }
     let mut mission = mission::Mission::new();
 
     for tick in 0..mission::MAX_TICKS {

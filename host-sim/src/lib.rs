@@ -5,6 +5,7 @@ pub mod analysis;
 pub mod faults;
 pub mod history;
 pub mod output;
+pub mod pil;
 pub mod plant;
 pub mod plots;
 pub mod reel;

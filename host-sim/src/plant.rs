@@ -131,12 +131,30 @@ impl Plant {
 
     /// One classical RK4 step of `h_s` seconds with the reel rate held at `rate_mps`.
     pub fn rk4_step(&self, x: &State, rate_mps: f64, h_s: f64) -> State {
+        self.rk4_step_varying(x, [rate_mps; 3], h_s)
+    }
+
+    /// One classical RK4 step of `h_s` seconds with a reel rate that varies over the step:
+    /// `rates_mps` = its values at the start, the middle and the end of the step (each stage
+    /// sees the rate at its own time, so l integrates it by Simpson's rule).
+    pub fn rk4_step_varying(&self, x: &State, rates_mps: [f64; 3], h_s: f64) -> State {
+        let [v0, v1, v2] = rates_mps;
         let f = self.frozen();
-        let k1 = self.derivative_with(&f, x, rate_mps);
-        let k2 = self.derivative_with(&f, &(x + k1 * (0.5 * h_s)), rate_mps);
-        let k3 = self.derivative_with(&f, &(x + k2 * (0.5 * h_s)), rate_mps);
-        let k4 = self.derivative_with(&f, &(x + k3 * h_s), rate_mps);
+        let k1 = self.derivative_with(&f, x, v0);
+        let k2 = self.derivative_with(&f, &(x + k1 * (0.5 * h_s)), v1);
+        let k3 = self.derivative_with(&f, &(x + k2 * (0.5 * h_s)), v1);
+        let k4 = self.derivative_with(&f, &(x + k3 * h_s), v2);
         x + (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h_s / 6.0)
+    }
+
+    /// The orbit rate θ̇ at true anomaly θ, rad/s (n on a circular orbit, without evaluating
+    /// cos θ).
+    pub fn orbit_rate_radps(&self, theta: f64) -> f64 {
+        if self.orbit.eccentricity == 0.0 {
+            self.orbit.mean_motion_radps()
+        } else {
+            self.orbit.true_anomaly_rate_radps(theta)
+        }
     }
 
     /// Tether tension from Eq. 5a with l̇ = `rate_mps` and l̈ = `accel_mps2`, N:
@@ -254,6 +272,23 @@ mod tests {
                             "{ecc} {rho} {x} {k}"
                         );
                     }
+                    let varying = p.rk4_step_varying(&x, [rate, 0.5 * rate, 0.25], 1.0);
+                    let k1 = reference_derivative(&p, &x, rate);
+                    let k2 = reference_derivative(&p, &(x + k1 * 0.5), 0.5 * rate);
+                    let k3 = reference_derivative(&p, &(x + k2 * 0.5), 0.5 * rate);
+                    let k4 = reference_derivative(&p, &(x + k3), 0.25);
+                    let expect = x + (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (1.0 / 6.0);
+                    for k in 0..6 {
+                        assert_eq!(
+                            varying[k].to_bits(),
+                            expect[k].to_bits(),
+                            "{ecc} {rho} {x} {k}"
+                        );
+                    }
+                    assert_eq!(
+                        p.orbit_rate_radps(th).to_bits(),
+                        p.orbit.true_anomaly_rate_radps(th).to_bits()
+                    );
                     let t = p.tension_n(&x, rate, 0.01);
                     let expect = reference_tension(&p, &x, rate, 0.01);
                     assert_eq!(t.to_bits(), expect.to_bits(), "{ecc} {rho} {x}");

@@ -32,6 +32,9 @@ pub struct RunArgs {
     /// `--set tether.density_kg_per_m=1e-3` (repeatable; applied in order).
     #[arg(long = "set", short = 's', value_name = "KEY=VALUE")]
     pub set: Vec<String>,
+    /// Processor-in-the-loop: `--pil [--firmware ELF]` (see `tss_sim::pil`).
+    #[command(flatten)]
+    pub pil: crate::pil::PilArgs,
 }
 
 /// A command-line mistake found before any work (exit code 2).
@@ -73,6 +76,9 @@ pub struct RunOutcome {
 
 /// `tss-sim run`: with the closed-loop simulation [`crate::sim::run`].
 pub fn run(args: RunArgs) -> anyhow::Result<()> {
+    if args.pil.enabled {
+        return crate::pil::run_cmd(&args);
+    }
     let mut outcome = run_with(&args, |scenario, probes, progress| {
         crate::sim::run(scenario, probes, progress)
     })?;

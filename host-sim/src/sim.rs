@@ -255,7 +255,7 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
             length_m: x[ix::LENGTH],
             alpha_rad: x[ix::ALPHA],
             alpha_rate_radps: x[ix::ALPHA_RATE],
-            orbit_rate_radps: plant.orbit.true_anomaly_rate_radps(x[ix::THETA]),
+            orbit_rate_radps: plant.orbit_rate_radps(x[ix::THETA]),
         };
         let sensed = injector.sense(tick, t_s, &truth);
         let out = match sensed {
@@ -335,11 +335,7 @@ fn rk4_with_reel(
 ) -> State {
     let v = |t: f64| reel.rate_after(command_mps, t);
     let (v0, v1, v2) = (v(t0_s), v(t0_s + 0.5 * h_s), v(t0_s + h_s));
-    let k1 = plant.derivative(x, v0);
-    let k2 = plant.derivative(&(x + k1 * (0.5 * h_s)), v1);
-    let k3 = plant.derivative(&(x + k2 * (0.5 * h_s)), v1);
-    let k4 = plant.derivative(&(x + k3 * h_s), v2);
-    x + (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h_s / 6.0)
+    plant.rk4_step_varying(x, [v0, v1, v2], h_s)
 }
 
 fn sample<T: Real>(x: &State, t_s: f64, tension_n: f64, out: &Output<T>) -> Sample {

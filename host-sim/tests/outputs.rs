@@ -187,6 +187,7 @@ fn synthetic_history_round_trips_through_the_outputs() {
         scenario: paper(),
         out: Some(out.clone()),
         set: vec![],
+        pil: Default::default(),
     };
     let history = synthetic(500);
     let expected = history.samples.clone();
@@ -217,6 +218,7 @@ fn a_failed_simulation_writes_nothing() {
         scenario: paper(),
         out: Some(out.clone()),
         set: vec![],
+        pil: Default::default(),
     };
     let e = run_with(&args, |_, _, _| {
         Err::<History, _>(std::io::Error::other("diverged"))

@@ -1,0 +1,648 @@
+//! # bench_step: instructions per controller step on the Cortex-M4F (QEMU `mps2-an386`)
+//!
+//! Flies `tss_reel::controller::Controller<f32>` over two recorded inputs and prints, with defmt,
+//! how many instructions one [`Controller::step`] takes (median, 99th percentile, worst) and
+//! where they go:
+//!
+//! 1. `replay`: the firmware's built-in input (`src/firmware/replay_data.rs`): the first 900 s
+//!    of the paper's mission, with the firmware's injected sensor dropout (ticks 400..450);
+//! 2. `mission`: the whole 20-hour paper mission (`examples/bench_step/mission.rs`: recorded
+//!    every 5 s by `tests/bench_data.rs`, interpolated to 1 s): deploy, keep, slew, retrieve,
+//!    keep, 72 001 steps.
+//!
+//! Run it with `scripts/bench-target`.
+//!
+//! ## How instructions are counted
+//!
+//! QEMU's DWT cycle counter reads zero, so the clock is SysTick. QEMU runs with
+//! `-icount shift=0`: every guest instruction advances virtual time by exactly 1 ns. SysTick is
+//! clocked from the processor clock (CLKSOURCE = 1), which is 25 MHz on `mps2-an386`, so one
+//! SysTick count is 40 ns = 40 instructions. The program checks that first (a loop of known
+//! length, `cortex_m::asm::delay`), and stops if it is not so.
+//!
+//! To beat the 40-instruction resolution, each measurement runs the same call on `K` copies of
+//! the same state (the controller is `Clone`; the pure functions get `K` copies of their
+//! input), each behind `core::hint::black_box` so nothing is hoisted or shared between copies,
+//! and divides by `K`. The cost of the timing loop itself (measured with an empty body) is
+//! subtracted. The figures are instructions, not cycles: on silicon a VDIV/VSQRT takes 14
+//! cycles and a taken branch 2–4, so cycles exceed instructions.
+//!
+//! ## The parts of a step
+//!
+//! On a step where the law ran (health `Nominal`), the public pieces the controller calls are
+//! timed separately, with the step's own arguments: the reference schedule (`BandSchedule::eval`
+//! or the stage-2 `SlewedSchedule::eval`), the implicit law (`law::solve`) and its acceleration
+//! (`law::acceleration`), the blend (`libm::expf`, which the step calls twice: once for the law,
+//! once for the output), the mass model (`MassModel::coefficients` twice and
+//! `MassModel::mu3_rate_per_s`, which calls it again), the equilibrium-existence check
+//! (`ExistenceMonitor::check_rate`) and the envelope (`Envelope::limit`). What is left of the
+//! step is the sensor validation (the monitor's checks), the sequencer and health state machine,
+//! dead reckoning and filling in the output.
+//!
+//! On the host this file compiles to an empty program.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+#![deny(unsafe_code)]
+
+/// Host stub: the benchmark runs only on the target (see the crate docs).
+#[cfg(not(target_os = "none"))]
+fn main() {}
+
+// The global logger and the panic handler, as in the firmware.
+#[cfg(target_os = "none")]
+use defmt_semihosting as _;
+#[cfg(target_os = "none")]
+use panic_probe as _;
+
+/// The firmware's exits and fault handlers (HardFault => failing exit), shared file.
+#[cfg(target_os = "none")]
+#[path = "../src/firmware/exit.rs"]
+mod exit;
+
+/// The firmware's built-in input: the first 900 s of the paper's mission.
+#[cfg(target_os = "none")]
+#[allow(dead_code)]
+#[path = "../src/firmware/replay_data.rs"]
+mod replay_data;
+
+/// The whole paper mission, recorded every 5 s, interpolated to 1 s.
+#[cfg(target_os = "none")]
+#[allow(dead_code)]
+#[path = "bench_step/mission.rs"]
+mod mission;
+
+#[cfg(target_os = "none")]
+mod bench {
+    use core::hint::black_box;
+    use cortex_m::peripheral::{syst::SystClkSource, SYST};
+    use tss_reel::controller::{Config, Controller, Health, Input, Output, Phase};
+    use tss_reel::equilibrium::{Anomaly, ExistenceMonitor};
+    use tss_reel::law::{self, LawInput};
+    use tss_reel::schedule::{Reference, SlewedSchedule};
+
+    /// Copies of the state each measurement runs on; the result is divided by this.
+    pub const K: usize = 16;
+
+    /// Whether this build also times the parts of each nominal step (`TSS_BENCH_PARTS` set at
+    /// build time). Calling `law::solve` & co. from the benchmark makes LLVM keep them as
+    /// functions of their own, where the flight build inlines them into the step, so the step's
+    /// own count is taken from a build without the parts (see the crate docs).
+    pub const TIME_PARTS: bool = matches!(option_env!("TSS_BENCH_PARTS"), Some(v) if !v.is_empty());
+
+    /// The processor clock of `mps2-an386` (QEMU's `SYSCLK_FRQ`), Hz.
+    const CORE_CLOCK_HZ: u32 = 25_000_000;
+
+    /// Virtual nanoseconds per instruction under `-icount shift=0` (2⁰).
+    const NS_PER_INSTRUCTION: u32 = 1;
+
+    /// Instructions per SysTick count: 40 at 25 MHz.
+    pub const INSTRUCTIONS_PER_COUNT: u32 = 1_000_000_000 / CORE_CLOCK_HZ / NS_PER_INSTRUCTION;
+
+    /// SysTick's reload value: the full 24-bit range (period 2²⁴ counts, 671 ms of virtual time).
+    const RELOAD: u32 = 0x00FF_FFFF;
+
+    /// The 500-instruction budget of one step (issue 7), checked against the worst case.
+    pub const BUDGET_INSTRUCTIONS: u32 = 500;
+
+    /// The free-running SysTick (no interrupt), counting processor clocks.
+    pub struct Meter {
+        _syst: SYST,
+        /// Instructions of the timing loop itself for `K` iterations (subtracted).
+        overhead_instructions: u32,
+    }
+
+    impl Meter {
+        /// Starts SysTick on the processor clock and calibrates the loop overhead.
+        pub fn start(mut syst: SYST) -> Self {
+            syst.disable_interrupt();
+            syst.set_clock_source(SystClkSource::Core);
+            syst.set_reload(RELOAD);
+            syst.clear_current();
+            syst.enable_counter();
+            let mut m = Self {
+                _syst: syst,
+                overhead_instructions: 0,
+            };
+            let mut empty = [0_u32; K];
+            // The smallest of a few runs: the loop's own cost.
+            let mut least = u32::MAX;
+            for _ in 0..8 {
+                least = least.min(m.raw(&mut empty, |s| *s));
+            }
+            m.overhead_instructions = least;
+            m
+        }
+
+        /// The loop overhead that is subtracted, instructions per `K` iterations.
+        pub fn overhead(&self) -> u32 {
+            self.overhead_instructions
+        }
+
+        /// SysTick counts between two readings of the down-counter (at most one wrap).
+        #[inline(always)]
+        fn counts(start: u32, end: u32) -> u32 {
+            start.wrapping_sub(end) & RELOAD
+        }
+
+        /// Instructions of `K` calls of `f`, one per state, loop included.
+        #[inline(never)]
+        fn raw<S, R>(&self, states: &mut [S; K], mut f: impl FnMut(&mut S) -> R) -> u32 {
+            let t0 = SYST::get_current();
+            for s in states.iter_mut() {
+                black_box(f(black_box(s)));
+            }
+            let t1 = SYST::get_current();
+            Self::counts(t0, t1) * INSTRUCTIONS_PER_COUNT
+        }
+
+        /// Instructions of one call of `f`: `K` calls on `K` copies, loop subtracted, ÷ `K`
+        /// (rounded to nearest; resolution 40/`K` instructions).
+        pub fn per_call<S, R>(&self, states: &mut [S; K], f: impl FnMut(&mut S) -> R) -> u32 {
+            let total = self
+                .raw(states, f)
+                .saturating_sub(self.overhead_instructions);
+            (total + K as u32 / 2) / K as u32
+        }
+
+        /// Instructions of one call of a pure function of `x`, timed on `K` copies of it.
+        pub fn pure<X: Copy, R>(&self, x: X, mut f: impl FnMut(&X) -> R) -> u32 {
+            let mut xs = [x; K];
+            self.per_call(&mut xs, |x| f(x))
+        }
+
+        /// Instructions measured around `asm::delay(n)`, which runs a two-instruction loop
+        /// (`subs`, `bne`) n + 1 times (cortex-m 0.7.10): 2n + 2 instructions, plus the reads.
+        pub fn instructions_of_delay(&self, n: u32) -> u32 {
+            let t0 = SYST::get_current();
+            cortex_m::asm::delay(n);
+            let t1 = SYST::get_current();
+            Self::counts(t0, t1) * INSTRUCTIONS_PER_COUNT
+        }
+    }
+
+    /// Distribution of per-step instruction counts: exact up to `BINS - 1`, then lumped.
+    pub struct Stats<const BINS: usize> {
+        hist: [u32; BINS],
+        /// Steps counted.
+        pub n: u32,
+        sum: u64,
+        /// The largest count and the tick it was seen at.
+        pub max: (u32, u32),
+    }
+
+    impl<const BINS: usize> Stats<BINS> {
+        pub const fn new() -> Self {
+            Self {
+                hist: [0; BINS],
+                n: 0,
+                sum: 0,
+                max: (0, 0),
+            }
+        }
+
+        pub fn add(&mut self, v: u32, tick: u32) {
+            self.hist[(v as usize).min(BINS - 1)] += 1;
+            self.n += 1;
+            self.sum += u64::from(v);
+            if v > self.max.0 || self.n == 1 {
+                self.max = (v, tick);
+            }
+        }
+
+        /// The smallest value with at least `per_mille`‰ of the counts at or below it.
+        pub fn quantile(&self, per_mille: u32) -> u32 {
+            let need = (u64::from(self.n) * u64::from(per_mille))
+                .div_ceil(1000)
+                .max(1);
+            let mut acc = 0_u64;
+            for (v, &c) in self.hist.iter().enumerate() {
+                acc += u64::from(c);
+                if acc >= need {
+                    return v as u32;
+                }
+            }
+            BINS as u32 - 1
+        }
+
+        pub fn median(&self) -> u32 {
+            self.quantile(500)
+        }
+
+        pub fn sum(&self) -> u64 {
+            self.sum
+        }
+
+        pub fn mean(&self) -> u32 {
+            if self.n == 0 {
+                0
+            } else {
+                (self.sum / u64::from(self.n)) as u32
+            }
+        }
+    }
+
+    /// Mean and worst of one phase's steps.
+    #[derive(Clone, Copy)]
+    struct PhaseStats {
+        n: u32,
+        sum: u64,
+        max: u32,
+    }
+
+    /// The pieces of a nominal step, in the order they are reported.
+    #[derive(Clone, Copy, PartialEq, Eq, defmt::Format)]
+    pub enum Part {
+        /// Reference angle α_r and its derivatives (Eqs. 34/35, stage-2 slew).
+        Schedule,
+        /// `law::solve`: the implicit Eqs. 27 + 29 (with sin_cos 2α and √).
+        LawSolve,
+        /// `law::acceleration`: Eq. 30.
+        LawAccel,
+        /// The Eq. 29 blend weight e^{−cτ}, `libm::expf`, twice per step.
+        BlendExp,
+        /// μ3 and dμ3/dl: `MassModel::coefficients` ×2 and `mu3_rate_per_s` (which calls it).
+        MassModel,
+        /// Eq. 13 existence margin: `ExistenceMonitor::check_rate`.
+        Existence,
+        /// Rate/acceleration/length limits: `Envelope::limit` (with two √).
+        Envelope,
+    }
+
+    const PARTS: [Part; 7] = [
+        Part::Schedule,
+        Part::LawSolve,
+        Part::LawAccel,
+        Part::BlendExp,
+        Part::MassModel,
+        Part::Existence,
+        Part::Envelope,
+    ];
+
+    /// Everything measured over one input sequence.
+    struct Run {
+        /// Every step.
+        pub step: Stats<2048>,
+        /// Steps where the law ran (health Nominal, no fault).
+        pub nominal: Stats<2048>,
+        /// The parts of the nominal steps.
+        pub parts: [Stats<1024>; PARTS.len()],
+        /// The rest of a nominal step: validation, sequencer, health, output.
+        pub rest: Stats<1024>,
+        phases: [PhaseStats; 5],
+        health: [u32; 3],
+    }
+
+    fn phase_index(p: Phase) -> usize {
+        match p {
+            Phase::Deploy => 0,
+            Phase::Keep1 => 1,
+            Phase::Slew => 2,
+            Phase::Retrieve => 3,
+            Phase::Keep2 => 4,
+        }
+    }
+
+    const PHASES: [Phase; 5] = [
+        Phase::Deploy,
+        Phase::Keep1,
+        Phase::Slew,
+        Phase::Retrieve,
+        Phase::Keep2,
+    ];
+
+    impl Run {
+        pub const fn new() -> Self {
+            Self {
+                step: Stats::new(),
+                nominal: Stats::new(),
+                parts: [const { Stats::new() }; PARTS.len()],
+                rest: Stats::new(),
+                phases: [PhaseStats {
+                    n: 0,
+                    sum: 0,
+                    max: 0,
+                }; 5],
+                health: [0; 3],
+            }
+        }
+    }
+
+    /// The controller's stage-2 start (the paper's 8 h), for the reference's stage time.
+    fn stage2_start_tick(cfg: &Config<f32>) -> u32 {
+        cfg.stage2.start_tick.unwrap_or(u32::MAX)
+    }
+
+    /// Times the public pieces of a nominal step at this sample, with the arguments the
+    /// controller gives them (see the crate docs). Returns each part's instructions.
+    fn time_parts(
+        m: &Meter,
+        cfg: &Config<f32>,
+        existence: &ExistenceMonitor<f32>,
+        x: &Input<f32>,
+        out: &Output<f32>,
+        previous_rate_mps: f32,
+    ) -> [u32; PARTS.len()] {
+        let l = x.length_m;
+        let stage2 = matches!(out.phase, Phase::Slew | Phase::Retrieve | Phase::Keep2);
+        let stage_start = if stage2 { stage2_start_tick(cfg) } else { 0 };
+        let tau_s = x.tick.saturating_sub(stage_start) as f32 * cfg.period_s;
+        let slewed = SlewedSchedule {
+            schedule: cfg.stage2.schedule,
+            slew_rate_radps: cfg.stage2.slew_rate_radps,
+        };
+        let stage1 = cfg.stage1.schedule;
+        let schedule = if stage2 {
+            m.pure((tau_s, l), |&(t, l)| slewed.eval(t, l))
+        } else {
+            m.pure(l, |&l| stage1.eval(l))
+        };
+        let reference = if stage2 {
+            slewed.eval(tau_s, l)
+        } else {
+            Reference {
+                angle: stage1.eval(l),
+                time_rate_radps: 0.0,
+                slewing: false,
+            }
+        };
+        let (decay, initial) = if stage2 {
+            (cfg.stage2.decay_rate_per_s, previous_rate_mps)
+        } else {
+            (cfg.stage1.decay_rate_per_s, cfg.initial_rate_mps)
+        };
+        let masses = cfg.masses;
+        let law_in = LawInput {
+            length_m: l,
+            alpha_rad: x.alpha_rad,
+            alpha_rate_radps: x.alpha_rate_radps,
+            orbit_rate_radps: x.orbit_rate_radps,
+            ref_angle_rad: reference.angle.angle_rad,
+            ref_slope_rad_per_m: reference.angle.slope_rad_per_m,
+            ref_curvature_rad_per_m2: reference.angle.curvature_rad_per_m2,
+            ref_time_rate_radps: reference.time_rate_radps,
+            mu3: masses.coefficients(l).mu3,
+            mu3_per_m: masses.mu3_rate_per_s(l, 1.0),
+            blend_weight: out.blend_weight,
+            decay_rate_per_s: decay,
+            initial_rate_mps: initial,
+            gains: cfg.gains,
+        };
+        let solve = m.pure(law_in, law::solve);
+        let solution = law::solve(&law_in);
+        let accel = match &solution {
+            Ok(s) => m.pure((law_in, *s), |(i, s)| law::acceleration(i, s)),
+            Err(_) => 0,
+        };
+        // The blend's argument −cτ, recovered from the reported weight.
+        let exponent = libm::logf(out.blend_weight.max(f32::MIN_POSITIVE));
+        let blend = 2 * m.pure(exponent, |&e| libm::expf(e));
+        let mass = 2 * m.pure(l, |&l| masses.coefficients(l))
+            + m.pure(l, |&l| masses.mu3_rate_per_s(l, 1.0));
+        let mu3 = law_in.mu3;
+        let rate = out.rate_cmd_mps;
+        let exist = m.pure((mu3, l, rate), |&(mu3, l, y)| {
+            existence.check_rate(Anomaly::WholeOrbit, mu3, l, y)
+        });
+        let env = cfg.envelope;
+        let requested = solution.map(|s| s.rate_mps).unwrap_or(rate);
+        let envelope = m.pure((requested, previous_rate_mps, l), |&(y, p, l)| {
+            env.limit(y, p, l, cfg.period_s)
+        });
+        [schedule, solve, accel, blend, mass, exist, envelope]
+    }
+
+    /// Flies a fresh paper-configured controller over `ticks` samples (`None`: a dropout) and
+    /// measures every step, and the parts of every nominal one.
+    fn run(
+        m: &Meter,
+        r: &mut Run,
+        ticks: u32,
+        orbit_rate_radps: f32,
+        mut sample: impl FnMut(u32) -> Option<[f32; 3]>,
+    ) {
+        let Ok(mut ctl) = Controller::new(Config::<f32>::paper()) else {
+            defmt::error!("the paper's configuration was rejected");
+            crate::exit::failure();
+        };
+        let cfg = *ctl.config();
+        let Ok(existence) = ExistenceMonitor::from_orbit(&cfg.orbit) else {
+            defmt::error!("no existence monitor for the paper's orbit");
+            crate::exit::failure();
+        };
+        let mut previous_rate = cfg.initial_rate_mps;
+        for tick in 0..ticks {
+            let input = sample(tick).map(|s| Input {
+                tick,
+                length_m: s[0],
+                alpha_rad: s[1],
+                alpha_rate_radps: s[2],
+                orbit_rate_radps,
+            });
+            let mut copies: [Controller<f32>; K] = core::array::from_fn(|_| ctl.clone());
+            let cost = match &input {
+                Some(x) => m.per_call(&mut copies, |c| c.step(black_box(x))),
+                None => m.per_call(&mut copies, |c| c.step_missing(black_box(tick))),
+            };
+            let out = match &input {
+                Some(x) => ctl.step(x),
+                None => ctl.step_missing(tick),
+            };
+            r.step.add(cost, tick);
+            let p = &mut r.phases[phase_index(out.phase)];
+            p.n += 1;
+            p.sum += u64::from(cost);
+            p.max = p.max.max(cost);
+            r.health[out.health as usize] += 1;
+            if let (Some(x), Health::Nominal, None) = (&input, out.health, out.fault) {
+                r.nominal.add(cost, tick);
+                if !TIME_PARTS {
+                    previous_rate = out.rate_cmd_mps;
+                    continue;
+                }
+                let parts = time_parts(m, &cfg, &existence, x, &out, previous_rate);
+                let mut sum = 0;
+                for (s, &v) in r.parts.iter_mut().zip(&parts) {
+                    s.add(v, tick);
+                    sum += v;
+                }
+                r.rest.add(cost.saturating_sub(sum), tick);
+            }
+            previous_rate = out.rate_cmd_mps;
+        }
+    }
+
+    /// Measures one input sequence (see [`run`]) and prints its figures. The figures live in
+    /// this function's frame only (about 50 KB of histograms), one sequence at a time.
+    #[inline(never)]
+    pub fn measure(
+        m: &Meter,
+        name: &str,
+        ticks: u32,
+        orbit_rate_radps: f32,
+        sample: impl FnMut(u32) -> Option<[f32; 3]>,
+    ) {
+        let mut r = Run::new();
+        run(m, &mut r, ticks, orbit_rate_radps, sample);
+        report(name, &r);
+    }
+
+    /// Prints one run's figures (the lines `scripts/bench-target` shows and checks).
+    fn report(name: &str, r: &Run) {
+        let s = &r.step;
+        if TIME_PARTS {
+            defmt::info!(
+                "{=str}: parts build: one step takes {=u32} instructions (median; more than in the step-only build because the timed parts are not inlined into it)",
+                name,
+                s.median()
+            );
+        } else {
+            report_steps(name, r);
+        }
+        let n = &r.nominal;
+        if !TIME_PARTS || n.n == 0 {
+            return;
+        }
+        let total = r.parts.iter().map(Stats::sum).sum::<u64>() + r.rest.sum();
+        let total = total.max(1);
+        for (part, st) in PARTS.iter().zip(&r.parts) {
+            defmt::info!(
+                "{=str}: part {}: median {=u32}, worst {=u32}, mean {=u32}, share {=u32}.{=u32} %",
+                name,
+                part,
+                st.median(),
+                st.max.0,
+                st.mean(),
+                (st.sum() * 100 / total) as u32,
+                (st.sum() * 1000 / total % 10) as u32
+            );
+        }
+        let st = &r.rest;
+        defmt::info!(
+            "{=str}: part Rest (validation, sequencer, health, output): median {=u32}, worst {=u32}, mean {=u32}, share {=u32}.{=u32} %",
+            name,
+            st.median(),
+            st.max.0,
+            st.mean(),
+            (st.sum() * 100 / total) as u32,
+            (st.sum() * 1000 / total % 10) as u32
+        );
+    }
+
+    /// The step figures of a run (step-only build).
+    fn report_steps(name: &str, r: &Run) {
+        let s = &r.step;
+        defmt::info!(
+            "{=str}: step instructions over {=u32} steps: median {=u32}, p99 {=u32}, worst {=u32} (tick {=u32}), mean {=u32}; budget {=u32}: {=str}",
+            name,
+            s.n,
+            s.median(),
+            s.quantile(990),
+            s.max.0,
+            s.max.1,
+            s.mean(),
+            BUDGET_INSTRUCTIONS,
+            if s.max.0 <= BUDGET_INSTRUCTIONS { "met" } else { "NOT MET" }
+        );
+        defmt::info!(
+            "{=str}: health Nominal {=u32}, Degraded {=u32}, SafeHold {=u32} steps",
+            name,
+            r.health[0],
+            r.health[1],
+            r.health[2]
+        );
+        for (i, p) in r.phases.iter().enumerate() {
+            if p.n > 0 {
+                defmt::info!(
+                    "{=str}: phase {}: {=u32} steps, mean {=u32}, worst {=u32}",
+                    name,
+                    PHASES[i],
+                    p.n,
+                    (p.sum / u64::from(p.n)) as u32,
+                    p.max
+                );
+            }
+        }
+        let n = &r.nominal;
+        if n.n > 0 {
+            defmt::info!(
+                "{=str}: nominal steps (law ran): {=u32}: median {=u32}, worst {=u32} (tick {=u32}), mean {=u32}",
+                name,
+                n.n,
+                n.median(),
+                n.max.0,
+                n.max.1,
+                n.mean()
+            );
+        }
+    }
+
+    /// Per-call instructions of the math primitives the step uses, at typical arguments.
+    pub fn primitives(m: &Meter) {
+        let sc = m.pure(-1.3_f32, |&x| tss_reel::fastmath::sin_cos(x));
+        let exp = m.pure(-3.2_f32, |&x| libm::expf(x));
+        let sqrt = m.pure(1.7e-7_f32, |&x| libm::sqrtf(x));
+        let rint = m.pure(-0.83_f32, |&x| libm::rintf(x));
+        let div = m.pure((1.7e-7_f32, 3.1_f32), |&(a, b)| a / b);
+        defmt::info!(
+            "primitives (instructions per call): fastmath::sin_cos {=u32}, libm::expf {=u32}, libm::sqrtf {=u32}, libm::rintf {=u32}, f32 division {=u32}",
+            sc,
+            exp,
+            sqrt,
+            rint,
+            div
+        );
+    }
+}
+
+#[cfg(target_os = "none")]
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    use bench::{Meter, INSTRUCTIONS_PER_COUNT, K};
+
+    let Some(core) = cortex_m::Peripherals::take() else {
+        defmt::error!("core peripherals already taken");
+        exit::failure();
+    };
+    let meter = Meter::start(core.SYST);
+    // 1 SysTick count must be 40 instructions (icount shift=0, 25 MHz SysTick): a delay loop
+    // of 400 000 instructions must read 400 000 ± a few counts' worth.
+    let delay = meter.instructions_of_delay(200_000);
+    defmt::info!(
+        "clock: {=u32} instructions per SysTick count (checked: a 400000-instruction delay loop reads {=u32}), K = {=usize} copies per measurement, loop overhead {=u32} instructions per {=usize} calls",
+        INSTRUCTIONS_PER_COUNT,
+        delay,
+        K,
+        meter.overhead(),
+        K
+    );
+    if delay.abs_diff(400_000) > 400 {
+        defmt::error!(
+            "the clock is not 1 instruction per ns: run QEMU with -icount shift=0 (scripts/bench-target)"
+        );
+        exit::failure();
+    }
+    bench::primitives(&meter);
+
+    bench::measure(
+        &meter,
+        "replay",
+        replay_data::SAMPLES.len() as u32,
+        replay_data::ORBIT_RATE_RADPS,
+        |tick| {
+            if (replay_data::DROPOUT_FROM_TICK..replay_data::DROPOUT_UNTIL_TICK).contains(&tick) {
+                None
+            } else {
+                replay_data::SAMPLES.get(tick as usize).copied()
+            }
+        },
+    );
+    bench::measure(
+        &meter,
+        "mission",
+        mission::TICKS,
+        mission::ORBIT_RATE_RADPS,
+        mission::sample,
+    );
+
+    defmt::info!("bench done");
+    exit::success()
+}

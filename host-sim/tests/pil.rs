@@ -1,0 +1,219 @@
+//! Processor-in-the-loop tests: the flight firmware ELF in QEMU flies the `tss-sim` plant over
+//! the emulated UART (`tss_sim::pil`).
+//!
+//! - `pil_flies_the_same_commands_as_the_host_linked_core`: the first 30 simulated minutes of
+//!   `scenarios/paper.toml`, every tick compared with the host-linked run: commands, lengths and
+//!   every other output bit for bit (the same f32 code on both sides).
+//! - `link_faults_are_dropouts_counted_on_both_sides`: the same stretch with every kind of link
+//!   fault injected; both ends count the same faults, the tether stays inside its envelope, and
+//!   a host-linked run with sensor dropouts at exactly the ticks the firmware had no sample
+//!   computes the same commands bit for bit.
+//!
+//! They need the firmware ELF (`cargo fw-build`, or `TSS_FIRMWARE_ELF`) and `qemu-system-arm`
+//! and `defmt-print` on PATH. Without them each test prints why and passes, unless
+//! `TSS_PIL_REQUIRED=1` (set by `scripts/test` and `scripts/pil-test`), which makes a missing
+//! prerequisite a failure. The ELF is not rebuilt here: `scripts/pil-test` builds it first.
+
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+use tss_reel::controller::{Controller, Input, Output};
+use tss_sim::history::History;
+use tss_sim::pil::{self, PilReport};
+use tss_sim::scenario::Scenario;
+use tss_sim::sim::{self, SimError, Stepper};
+
+/// One QEMU at a time: two cores, and a stalled host would make the firmware time out.
+static QEMU: Mutex<()> = Mutex::new(());
+
+/// The simulated stretch: the first 30 minutes of the paper's mission (deployment).
+const DURATION_S: &str = "simulation.duration_s=1800";
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// The firmware ELF, or `None` (with the reason printed) if PIL cannot run here.
+fn firmware() -> Option<PathBuf> {
+    let elf = std::env::var_os("TSS_FIRMWARE_ELF")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join(pil::DEFAULT_FIRMWARE));
+    let mut missing = Vec::new();
+    if !elf.is_file() {
+        missing.push(format!(
+            "the firmware ELF {} (build it with `cargo fw-build`)",
+            elf.display()
+        ));
+    }
+    for tool in ["qemu-system-arm", "defmt-print"] {
+        let found = std::process::Command::new(tool)
+            .arg("--version")
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .status()
+            .is_ok();
+        if !found {
+            missing.push(format!("`{tool}` (scripts/setup installs it)"));
+        }
+    }
+    if missing.is_empty() {
+        return Some(elf);
+    }
+    let why = format!("PIL test skipped: missing {}", missing.join(" and "));
+    if std::env::var("TSS_PIL_REQUIRED").is_ok_and(|v| v == "1") {
+        panic!("{why}; TSS_PIL_REQUIRED=1 makes that a failure");
+    }
+    eprintln!("{why}");
+    None
+}
+
+fn scenario(overrides: &[&str]) -> Scenario {
+    let mut sets = vec![
+        DURATION_S.to_string(),
+        "simulation.output_interval_s=1".to_string(),
+    ];
+    sets.extend(overrides.iter().map(|s| s.to_string()));
+    Scenario::load(root().join("scenarios/paper.toml"), &sets).unwrap()
+}
+
+fn run_pil(sc: &Scenario, elf: &PathBuf, name: &str) -> (History, PilReport) {
+    let dir = std::env::temp_dir().join(format!("tss-pil-test-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let log = dir.join("firmware.log");
+    match pil::run(sc, elf, &log, &[], &mut |_| {}) {
+        Ok(r) => r,
+        Err(e) => {
+            let log_text = std::fs::read_to_string(&log).unwrap_or_default();
+            panic!("PIL run failed: {e:#?}\nfirmware log:\n{log_text}");
+        }
+    }
+}
+
+/// Largest |a − b| of one field over two histories of the same ticks.
+fn max_diff(a: &History, b: &History, f: impl Fn(&tss_sim::history::Sample) -> f64) -> f64 {
+    a.samples
+        .iter()
+        .zip(&b.samples)
+        .map(|(x, y)| (f(x) - f(y)).abs())
+        .fold(0.0, f64::max)
+}
+
+/// Every sample equal bit for bit (`{:?}` of f64 is exact and tells NaNs apart from numbers).
+fn assert_identical(a: &History, b: &History) {
+    assert_eq!(a.samples.len(), b.samples.len());
+    for (x, y) in a.samples.iter().zip(&b.samples) {
+        assert_eq!(
+            format!("{x:?}"),
+            format!("{y:?}"),
+            "first difference at t = {} s",
+            x.t_s
+        );
+    }
+    assert_eq!(a.faults, b.faults, "fault summaries differ");
+}
+
+#[test]
+fn pil_flies_the_same_commands_as_the_host_linked_core() {
+    let Some(elf) = firmware() else { return };
+    let _one = QEMU.lock().unwrap_or_else(|e| e.into_inner());
+    let sc = scenario(&[]);
+    let host = sim::run(&sc, &[], &mut |_| {}).unwrap();
+    let (pil, report) = run_pil(&sc, &elf, "agreement");
+    eprint!("{}", report.render());
+    assert_eq!(
+        report.spurious_timeouts, 0,
+        "the host stalled past the firmware's timeout"
+    );
+    assert!(report.consistent());
+    assert_eq!(report.ticks, 1801);
+    assert_eq!(report.status.fresh, 1801);
+
+    let d_cmd = max_diff(&host, &pil, |s| s.length_rate_mps);
+    let d_len = max_diff(&host, &pil, |s| s.length_m);
+    eprintln!(
+        "PIL vs host-linked over {} ticks: max |Δ command| = {d_cmd:e} m/s, max |Δ length| = {d_len:e} m",
+        pil.samples.len()
+    );
+    assert_identical(&host, &pil);
+}
+
+/// The host-linked core, with a dropout forced at the given ticks (those the firmware had no
+/// sample for).
+struct DropoutsAt<'a> {
+    core: Controller<f32>,
+    ticks: &'a [u32],
+}
+
+impl Stepper<f32> for DropoutsAt<'_> {
+    fn step(&mut self, tick: u32, input: Option<&Input<f32>>) -> Result<Output<f32>, SimError> {
+        let input = input.filter(|_| self.ticks.binary_search(&tick).is_err());
+        Stepper::step(&mut self.core, tick, input)
+    }
+}
+
+#[test]
+fn link_faults_are_dropouts_counted_on_both_sides() {
+    let Some(elf) = firmware() else { return };
+    let _one = QEMU.lock().unwrap_or_else(|e| e.into_inner());
+    // Cheap faults (corrupted, duplicated) often; those that cost the firmware a timeout
+    // (dropped, reordered: about 1.6 s of wall time each) rarely.
+    let sc = scenario(&[
+        "link.seed=2011",
+        "link.corrupt_prob=0.03",
+        "link.duplicate_prob=0.03",
+        "link.drop_prob=0.005",
+        "link.reorder_prob=0.005",
+    ]);
+    let (pil, report) = run_pil(&sc, &elf, "faults");
+    eprint!("{}", report.render());
+    let i = report.injected;
+    assert!(
+        i.dropped > 0 && i.corrupted > 0 && i.duplicated > 0 && i.reordered > 0,
+        "every kind of fault injected: {i:?}"
+    );
+    assert_eq!(
+        report.spurious_timeouts, 0,
+        "the host stalled past the firmware's timeout"
+    );
+    assert_eq!(
+        report.firmware_counts(),
+        report.expected_firmware_counts(),
+        "the firmware counted what the plant injected"
+    );
+    assert!(report.consistent());
+    assert_eq!(
+        report.missing_ticks.len() as u32,
+        i.dropped + i.corrupted + i.reordered
+    );
+    assert_eq!(report.status.timeout, i.dropped + i.reordered);
+    assert_eq!(report.status.corrupted, i.corrupted);
+
+    let f = &pil.faults;
+    assert_eq!(f.outside_envelope_s, 0.0, "the tether left its envelope");
+    assert_eq!(f.rate_exceeded_ticks, 0);
+    assert_eq!(f.accel_exceeded_ticks, 0);
+
+    // A link fault is exactly a sensor dropout: the core, with dropouts at the same ticks,
+    // computes the same mission bit for bit.
+    let core = Controller::new(sim::controller_config::<f32>(&sc).unwrap()).unwrap();
+    let mut replay = DropoutsAt {
+        core,
+        ticks: &report.missing_ticks,
+    };
+    let host = sim::run_stepper(&sc, &mut replay, &[], &mut |_| {}).unwrap();
+    let d_cmd = max_diff(&host, &pil, |s| s.length_rate_mps);
+    eprintln!("PIL with link faults vs host-linked with the same dropouts: max |Δ command| = {d_cmd:e} m/s");
+    let mut pil_faults = pil.faults.clone();
+    // The host-linked run counts its dropouts as missing ticks; the PIL plant sent samples.
+    pil_faults.missing_ticks = host.faults.missing_ticks;
+    assert_eq!(pil.samples.len(), host.samples.len());
+    for (x, y) in host.samples.iter().zip(&pil.samples) {
+        assert_eq!(
+            format!("{x:?}"),
+            format!("{y:?}"),
+            "first difference at t = {} s",
+            x.t_s
+        );
+    }
+    assert_eq!(host.faults, pil_faults);
+}

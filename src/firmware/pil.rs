@@ -1,0 +1,375 @@
+//! Processor-in-the-loop (PIL): the flight controller closes the loop with the `tss-sim` plant
+//! over UART0, one frame pair per control period (`tss-sim run --pil`, `host-sim/src/pil.rs`).
+//!
+//! The firmware announces itself with a `Hello` frame (protocol version, the digest of the
+//! controller configuration it flies, its period and sample timeout), then, for every control
+//! period: waits for the plant's `Sample` frame, runs [`tss_reel::hal::control_cycle`] with the
+//! sample behind the HAL sensor traits, and sends the `Command` frame (the whole controller
+//! output, so the plant side writes the same history as a host-linked run). An `End` frame
+//! closes the run: the firmware answers with a `Report` (its link counters and the digest of
+//! its commands), logs them, and exits with success.
+//!
+//! **Time.** The plant is the clock: the tick number in the sample frame is the authority, and
+//! the firmware never runs ahead of the plant, because it blocks (bounded) on each sample.
+//! SysTick keeps running and serves as the timeout: a sample that has not arrived after
+//! [`TIMEOUT_TICKS`] SysTick periods is missing. Under QEMU's instruction counting
+//! (`-icount shift=5,align=off,sleep=off`) the wait is a busy poll, so emulated time advances
+//! with the polls: the timeout is between one and two control periods of emulated time,
+//! whatever the host's speed. (A WFI would let QEMU skip straight to the next SysTick, before
+//! the plant has sent anything.) The log's timestamps are SysTick time since boot, not mission
+//! time; every line names its tick.
+//!
+//! **Link faults.** A period whose sample frame is missing (timeout), corrupted (COBS, CRC,
+//! version, … — see [`tss_reel::link`]) or reports no sample upstream is a failed sensor read
+//! (`ErrorKind::NoSample` / `ErrorKind::Corrupted`): the controller steps without a sample
+//! (`Controller::step_missing`), exactly as in a sensor dropout. Duplicated and late
+//! (out-of-order) sample frames are discarded without using up the period, so the firmware
+//! keeps waiting for the right one. Every fault is logged with its tick and counted
+//! ([`tss_reel::link::LinkCounters`]); the counters are logged and reported at the end.
+
+use embedded_io::Write as _;
+use tss_reel::controller::{Config, Controller, Output};
+use tss_reel::hal::{
+    control_cycle, Devices, ErrorKind, ErrorType, LengthSensor, OrbitRateSource, ReelDrive, Swing,
+    SwingSensor,
+};
+use tss_reel::link::{
+    self, Command, FrameReader, Gate, Hello, LinkCounters, LinkError, Message, Report, Sample,
+    SampleGate, SampleStatus, MAX_WIRE_LEN, SAMPLE_VALID,
+};
+
+use super::clock::{self, ControlClock};
+use super::exit;
+use super::mission::CONTROL_PERIOD_MS;
+use super::uart::{Uart, UartError};
+
+/// SysTick periods the firmware waits for a sample frame before it steps without one. Two, so
+/// the wait lasts at least one full control period wherever in a period it starts.
+pub const TIMEOUT_TICKS: u32 = 2;
+
+/// Hard bound on the control periods of one PIL run: the paper's 20 h mission (72 001 ticks)
+/// with room to spare. A run still going then is a failure, never a hang.
+pub const MAX_TICKS: u32 = 200_000;
+
+/// Timeouts in a row after which the plant is taken to be gone: the run ends with a failure.
+pub const MAX_SILENT_PERIODS: u32 = 600;
+
+/// Largest number of UART polls in one wait: a bound on the loop should SysTick stop.
+const MAX_POLLS_PER_WAIT: u32 = 1 << 28;
+
+/// What one wait on the link produced.
+enum Received {
+    /// A sample frame for the awaited period (or a later one).
+    Sample(Sample),
+    /// No valid sample frame in time.
+    Timeout,
+    /// A frame that failed its checks.
+    Corrupted(LinkError),
+    /// The plant ended the run after this many periods.
+    End(u32),
+}
+
+/// This period's sample as the sensors see it: readings, or why there are none.
+#[derive(Clone, Copy)]
+struct LinkSample(Result<Sample, ErrorKind>);
+
+impl ErrorType for LinkSample {
+    type Error = ErrorKind;
+}
+
+impl LengthSensor for LinkSample {
+    fn read_length_m(&mut self, _tick: u32) -> Result<f32, ErrorKind> {
+        self.0.map(|s| s.length_m)
+    }
+}
+
+impl SwingSensor for LinkSample {
+    fn read_swing(&mut self, _tick: u32) -> Result<Swing, ErrorKind> {
+        self.0.map(|s| Swing {
+            alpha_rad: s.alpha_rad,
+            alpha_rate_radps: s.alpha_rate_radps,
+        })
+    }
+}
+
+impl OrbitRateSource for LinkSample {
+    fn read_orbit_rate_radps(&mut self, _tick: u32) -> Result<f32, ErrorKind> {
+        self.0.map(|s| s.orbit_rate_radps)
+    }
+}
+
+/// The UART end of the link: frames in (with the sequence checks), frames out.
+struct Link {
+    uart: Uart,
+    reader: FrameReader,
+    gate: SampleGate,
+    counters: LinkCounters,
+    /// Sequence number of the next frame sent.
+    seq: u32,
+    /// Frames that could not be sent (encoding or UART failure).
+    send_errors: u32,
+}
+
+impl Link {
+    fn send(&mut self, message: &Message) -> Result<(), ErrorKind> {
+        let mut wire = [0u8; MAX_WIRE_LEN];
+        let sent = link::encode(self.seq, message, &mut wire)
+            .map_err(|_| ErrorKind::Other)
+            .and_then(|n| {
+                let bytes = wire.get(..n).ok_or(ErrorKind::Other)?;
+                self.uart.write_all(bytes).map_err(|_| ErrorKind::Device)
+            });
+        self.seq = self.seq.wrapping_add(1);
+        if sent.is_err() {
+            self.send_errors = self.send_errors.saturating_add(1);
+        }
+        sent
+    }
+
+    /// Waits for the sample of period `awaited` (`None`: the first one), at most
+    /// [`TIMEOUT_TICKS`] SysTick periods.
+    fn receive(&mut self, awaited: Option<u32>) -> Received {
+        let start = clock::ticks();
+        for _ in 0..MAX_POLLS_PER_WAIT {
+            let byte = match self.uart.try_read_byte() {
+                Ok(Some(b)) => b,
+                Ok(None) => {
+                    if clock::ticks().wrapping_sub(start) >= TIMEOUT_TICKS {
+                        break;
+                    }
+                    continue;
+                }
+                Err(UartError::Overrun) => {
+                    defmt::warn!("link: UART receive overrun (a byte was lost)");
+                    continue;
+                }
+                Err(UartError::TimedOut) => continue,
+            };
+            let Some(decoded) = self.reader.push(byte) else {
+                continue;
+            };
+            let frame = match decoded {
+                Ok(f) => f,
+                Err(e) => {
+                    self.counters.count_error(e);
+                    return Received::Corrupted(e);
+                }
+            };
+            match frame.message {
+                Message::Sample(s) => {
+                    match self.gate.check(frame.seq, s, awaited, &mut self.counters) {
+                        Gate::Accept(s) => return Received::Sample(s),
+                        Gate::Duplicate => defmt::warn!(
+                            "link: duplicate sample frame seq={=u32} t={=u32} discarded",
+                            frame.seq,
+                            s.tick
+                        ),
+                        Gate::OutOfOrder => defmt::warn!(
+                            "link: late sample frame seq={=u32} t={=u32} discarded",
+                            frame.seq,
+                            s.tick
+                        ),
+                    }
+                }
+                Message::End(e) => return Received::End(e.ticks),
+                Message::Hello(_) | Message::Command(_) | Message::Report(_) => {
+                    self.counters.count_error(LinkError::WrongKind);
+                    defmt::warn!(
+                        "link: unexpected frame kind discarded (seq={=u32})",
+                        frame.seq
+                    );
+                }
+            }
+        }
+        self.counters.timeouts = self.counters.timeouts.saturating_add(1);
+        Received::Timeout
+    }
+}
+
+/// The reel drive of PIL: each command goes out as a `Command` frame.
+struct CommandLink<'a> {
+    link: &'a mut Link,
+    /// How this period's sample arrived (reported with the command).
+    status: SampleStatus,
+    /// Commands sent, and the FNV-1a digest of their rate bit patterns.
+    count: u32,
+    digest: u32,
+}
+
+impl ErrorType for CommandLink<'_> {
+    type Error = ErrorKind;
+}
+
+impl ReelDrive for CommandLink<'_> {
+    fn command(&mut self, output: &Output<f32>) -> Result<(), ErrorKind> {
+        self.link
+            .send(&Message::Command(Command::from_output(output, self.status)))?;
+        self.count = self.count.saturating_add(1);
+        self.digest = link::fnv1a_f32(self.digest, output.rate_cmd_mps);
+        Ok(())
+    }
+}
+
+/// Runs the PIL mission until the plant ends it; never returns.
+///
+/// It owns the running control clock: SysTick is the sample timeout's time base.
+pub fn run(_clock: ControlClock) -> ! {
+    let cfg = Config::paper();
+    let digest = link::config_digest(&cfg);
+    let mut controller = match Controller::new(cfg) {
+        Ok(c) => c,
+        Err(e) => {
+            defmt::error!("controller configuration rejected: {}", e);
+            exit::failure();
+        }
+    };
+    let mut link = Link {
+        uart: Uart::uart0(),
+        reader: FrameReader::new(),
+        gate: SampleGate::new(),
+        counters: LinkCounters::default(),
+        seq: 0,
+        send_errors: 0,
+    };
+    defmt::info!(
+        "PIL: link v{=u8} on UART0, config digest {=u32:#010x}, sample timeout {=u32} periods",
+        link::VERSION,
+        digest,
+        TIMEOUT_TICKS
+    );
+    let hello = Hello {
+        config_digest: digest,
+        period_ms: CONTROL_PERIOD_MS,
+        timeout_periods: TIMEOUT_TICKS as u8,
+    };
+    if link.send(&Message::Hello(hello)).is_err() {
+        defmt::error!("PIL: could not send the hello frame");
+        exit::failure();
+    }
+
+    let mut awaited: Option<u32> = None;
+    let mut silent = 0u32;
+    let mut count = 0u32;
+    let mut digest = link::fnv1a_start();
+    let mut dropouts = 0u32;
+    for _ in 0..MAX_TICKS {
+        let received = link.receive(awaited);
+        let (tick, status, reading) = match received {
+            Received::End(ticks) => finish(&mut link, ticks, count, digest, dropouts),
+            Received::Sample(s) => {
+                silent = 0;
+                if let Some(a) = awaited.filter(|&a| s.tick > a) {
+                    defmt::warn!("t={=u32} link: jumped from awaited tick {=u32}", s.tick, a);
+                }
+                if s.status == SAMPLE_VALID {
+                    (s.tick, SampleStatus::Fresh, Ok(s))
+                } else {
+                    (s.tick, SampleStatus::NoSample, Err(ErrorKind::NoSample))
+                }
+            }
+            Received::Timeout | Received::Corrupted(_) => {
+                silent = silent.saturating_add(1);
+                if silent > MAX_SILENT_PERIODS {
+                    defmt::error!("PIL: no sample for {=u32} periods: link lost", silent);
+                    log_counters(&link, count, digest, dropouts);
+                    exit::failure();
+                }
+                // Before the first sample the mission has not started: nothing to step.
+                let Some(a) = awaited else {
+                    continue;
+                };
+                match received {
+                    Received::Corrupted(e) => {
+                        defmt::warn!("t={=u32} link: corrupted sample frame: {}", a, e);
+                        (a, SampleStatus::Corrupted, Err(ErrorKind::Corrupted))
+                    }
+                    _ => {
+                        defmt::warn!("t={=u32} link: no sample frame (timeout)", a);
+                        (a, SampleStatus::Timeout, Err(ErrorKind::NoSample))
+                    }
+                }
+            }
+        };
+        let sample = LinkSample(reading);
+        let mut reel = CommandLink {
+            link: &mut link,
+            status,
+            count,
+            digest,
+        };
+        let mut devices = Devices {
+            length: sample,
+            swing: sample,
+            orbit: sample,
+            reel: &mut reel,
+        };
+        let cycle = control_cycle(&mut controller, tick, &mut devices);
+        count = reel.count;
+        digest = reel.digest;
+        if cycle.sensor_error.is_some() {
+            dropouts = dropouts.saturating_add(1);
+        }
+        if let Some(e) = cycle.reel_error {
+            defmt::error!("t={=u32} the command frame could not be sent: {}", tick, e);
+            exit::failure();
+        }
+        awaited = Some(tick.saturating_add(1));
+    }
+    defmt::error!(
+        "PIL: the plant did not end the run within {=u32} periods",
+        MAX_TICKS
+    );
+    log_counters(&link, count, digest, dropouts);
+    exit::failure()
+}
+
+/// Answers the plant's `End` with the `Report`, logs the counters and exits with success.
+fn finish(link: &mut Link, ticks: u32, commands: u32, digest: u32, dropouts: u32) -> ! {
+    defmt::info!(
+        "PIL: plant ended the run after {=u32} periods; {=u32} commands sent",
+        ticks,
+        commands
+    );
+    let report = Report {
+        counters: link.counters,
+        commands,
+        digest,
+    };
+    let sent = link.send(&Message::Report(report));
+    let flushed = link.uart.flush();
+    log_counters(link, commands, digest, dropouts);
+    if sent.is_err() || flushed.is_err() {
+        defmt::error!("PIL: the report frame could not be sent");
+        exit::failure();
+    }
+    exit::success()
+}
+
+fn log_counters(link: &Link, commands: u32, digest: u32, dropouts: u32) {
+    let c = &link.counters;
+    defmt::info!(
+        "PIL link: {=u32} samples used, {=u32} commands (digest {=u32:#010x}), {=u32} periods without a sample",
+        c.frames_ok,
+        commands,
+        digest,
+        dropouts
+    );
+    defmt::info!(
+        "PIL link faults: timeouts={=u32} decode errors={=u32} (crc={=u32} cobs={=u32} truncated={=u32} version={=u32} kind={=u32} malformed={=u32} wrong-kind={=u32} overflow={=u32}) duplicates={=u32} late={=u32} seq gaps={=u32} uart overruns={=u32} send errors={=u32}",
+        c.timeouts,
+        c.decode_errors(),
+        c.crc_errors,
+        c.cobs_errors,
+        c.truncated,
+        c.version_errors,
+        c.unknown_kind,
+        c.malformed,
+        c.wrong_kind,
+        c.overflows,
+        c.duplicates,
+        c.out_of_order,
+        c.seq_gaps,
+        link.uart.overruns(),
+        link.send_errors
+    );
+}

@@ -1,0 +1,130 @@
+#!/usr/bin/env python3
+"""Where the instructions of one control tick go, in the flight firmware itself.
+
+Runs a firmware ELF in QEMU (mps2-an386) with one instruction per translation block and the
+execution log on (`-singlestep -d exec,nochain`), cuts the log at SysTick entries into control
+ticks, and attributes every instruction of tick N to the source function it came from, through
+the inlining chain (llvm-symbolizer --inlining). So the breakdown is that of the flight codegen,
+with everything LLVM inlined into `Controller::step` sorted back into the paper's pieces.
+
+    tools/trace_profile.py [--elf ELF] [--tick N] [--top K]
+
+Defaults: the flight firmware (target/thumbv7em-none-eabihf/firmware/tss-reel, build it with
+`cargo fw-build`), tick 301 (a nominal deploy step that logs nothing). Needs qemu-system-arm
+and llvm-symbolizer (Debian: apt-get install llvm). The trace of 900 ticks is about 150 MB and
+is written to a temporary directory. Figures only; not part of CI.
+"""
+import argparse
+import collections
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+# (category, pattern over the inlining chain, innermost first); the first match wins.
+CATEGORIES = [
+    ("schedule (α_r: BandSchedule/SlewedSchedule)", r"schedule::|Controller.*::reference"),
+    ("law::solve: fastmath::sin_cos", r"fastmath::sin_cos.*law::solve"),
+    ("law::solve: libm::sqrtf", r"sqrt.*law::solve"),
+    ("law::solve: the rest", r"law::solve"),
+    ("law::acceleration", r"law::acceleration"),
+    ("envelope: libm::sqrtf", r"sqrt.*Envelope.*::limit"),
+    ("envelope: the rest", r"Envelope.*::limit"),
+    ("blend e^(-cτ): libm::expf", r"expf"),
+    ("mass model (coefficients, mu3_rate)", r"MassModel"),
+    ("existence check (Eq. 13 margin)", r"equilibrium::|equilibrium_margin"),
+    ("sensor validation (Monitor::check)", r"Monitor.*::check"),
+    ("libm::sqrtf (other)", r"sqrt"),
+    ("controller: sequencer, health, dead reckoning, output", r"controller::"),
+    ("HAL: control_cycle, replay sensors, telemetry digest", r"hal::|Replay|TelemetryReel|control_cycle"),
+    ("mission/main loop, clock, SysTick", r"mission::|clock::|SysTick|main|wfi|interrupt"),
+]
+
+
+def demangle_short(name):
+    for _ in range(5):
+        name = re.sub(r"<[^<>]*>", "", name)
+    name = re.sub(r"::h[0-9a-f]{16}$", "", name)
+    return name.replace("$LT$", "<").replace("$GT$", ">")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--elf", default="target/thumbv7em-none-eabihf/firmware/tss-reel")
+    ap.add_argument("--tick", type=int, default=301)
+    ap.add_argument("--top", type=int, default=25)
+    a = ap.parse_args()
+
+    with tempfile.TemporaryDirectory() as tmp:
+        log = os.path.join(tmp, "trace.log")
+        subprocess.run(
+            ["qemu-system-arm", "-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic",
+             "-semihosting-config", "enable=on,target=native",
+             "-icount", "shift=5,align=off,sleep=off", "-singlestep", "-d", "exec,nochain",
+             "-D", log, "-kernel", a.elf],
+            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, check=True, timeout=600)
+        pcs, ticks, prev, inside = [], -1, None, False
+        pat = re.compile(r"Trace \d+: \S+ \[[0-9a-f]+/([0-9a-f]+)/")
+        with open(log) as f:
+            for line in f:
+                m = pat.match(line)
+                if not m:
+                    continue
+                name = line.rsplit("]", 1)[1].strip()
+                if name == "SysTick" and prev != "SysTick":
+                    ticks += 1
+                    if ticks == a.tick + 1:
+                        break
+                prev = name
+                if ticks == a.tick:
+                    pcs.append(int(m.group(1), 16))
+    if not pcs:
+        sys.exit(f"trace_profile: tick {a.tick} not reached")
+
+    # Function extents, to follow calls into functions LLVM kept out of line (libm's sqrtf,
+    # expf, the compiler's soft-float helpers): a shadow call stack over the trace.
+    nm = subprocess.run(["llvm-nm", "-S", "--defined-only", a.elf], capture_output=True,
+                        text=True, check=True).stdout
+    extent = {}
+    for line in nm.splitlines():
+        parts = line.split()
+        if len(parts) == 4 and parts[2] in "tTwW":
+            start = int(parts[0], 16) & ~1
+            extent[start] = start + int(parts[1], 16)
+
+    uniq = sorted(set(pcs))
+    out = subprocess.run(
+        ["llvm-symbolizer", "--inlining", "--functions=linkage", "--demangle", "--obj=" + a.elf],
+        input="\n".join(f"0x{p:x}" for p in uniq), capture_output=True, text=True, check=True
+    ).stdout
+    chains = {}
+    for pc, block in zip(uniq, out.strip().split("\n\n")):
+        lines = block.split("\n")
+        chains[pc] = [demangle_short(lines[i]) for i in range(0, len(lines) - 1, 2)]
+
+    by_cat, by_fn = collections.Counter(), collections.Counter()
+    stack, prev_pc = [], None  # [(start, end, caller's chain)]
+    for pc in pcs:
+        while stack and not stack[-1][0] <= pc < stack[-1][1]:
+            stack.pop()
+        if pc in extent and prev_pc is not None and not pc <= prev_pc < extent[pc]:
+            caller = chains[prev_pc] + (stack[-1][2] if stack else [])
+            stack.append((pc, extent[pc], caller))
+        prev_pc = pc
+        full = chains[pc] + (stack[-1][2] if stack else [])
+        chain = " < ".join(full)
+        cat = next((c for c, p in CATEGORIES if re.search(p, chain)), "other: " + full[-1])
+        by_cat[cat] += 1
+        by_fn[chains[pc][0]] += 1
+    total = len(pcs)
+    print(f"{a.elf}: tick {a.tick}: {total} instructions, SysTick entry to SysTick entry")
+    for cat, n in by_cat.most_common():
+        print(f"  {n:6d}  {100 * n / total:5.1f} %  {cat}")
+    print(f"innermost source functions (top {a.top}):")
+    for fn, n in by_fn.most_common(a.top):
+        print(f"  {n:6d}  {fn}")
+
+
+if __name__ == "__main__":
+    main()
