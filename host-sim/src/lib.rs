@@ -4,6 +4,7 @@
 pub mod analysis;
 pub mod faults;
 pub mod history;
+pub mod montecarlo;
 pub mod output;
 pub mod pil;
 pub mod plant;

@@ -6,7 +6,7 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use tss_sim::{analysis, run_cmd};
+use tss_sim::{analysis, montecarlo, run_cmd};
 
 /// Exit code for usage errors (as clap uses for bad arguments).
 const EXIT_USAGE: u8 = 2;
@@ -33,6 +33,11 @@ enum Command {
     /// Characteristic roots, D1, D2 and verdicts at one state (Eqs. 17–19), with an eigenvalue
     /// cross-check.
     Stability(analysis::StabilityArgs),
+    /// Monte Carlo campaign: fly the scenario N times with its `[montecarlo]` dispersions (in
+    /// parallel, reproducible from the seed), write runs.csv, summary.txt and figures.
+    Montecarlo(montecarlo::MonteCarloArgs),
+    /// Combine the output directories of `montecarlo --shard K/N` into the whole campaign's.
+    Merge(montecarlo::MergeArgs),
 }
 
 fn main() -> ExitCode {
@@ -41,6 +46,8 @@ fn main() -> ExitCode {
         Command::Run(args) => run_cmd::run(args),
         Command::Extent(args) => analysis::run_extent(&args),
         Command::Stability(args) => analysis::run_stability(&args),
+        Command::Montecarlo(args) => montecarlo::montecarlo(&args),
+        Command::Merge(args) => montecarlo::merge(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

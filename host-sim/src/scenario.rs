@@ -30,6 +30,10 @@ pub struct Scenario {
     pub stage2: Stage2Section,
     /// Run length and output.
     pub simulation: SimulationSection,
+    /// A Monte Carlo campaign on this scenario: dispersions and pass/fail criteria
+    /// (`tss-sim montecarlo`; default: none; `tss-sim run` ignores it).
+    #[serde(default)]
+    pub montecarlo: crate::montecarlo::MonteCarloSection,
     /// Reel limits enforced by the controller (defaults: the paper's, 15 m/s, 15 m/s², 0.5 m to
     /// 40 km, wide enough never to act in the paper's mission).
     #[serde(default)]
@@ -896,6 +900,9 @@ impl Scenario {
                 false,
             );
         }
+
+        // [montecarlo]: dispersed fields that exist, complete distributions, sane criteria.
+        v.problems.extend(crate::montecarlo::problems(s));
 
         // [sensors]: finite errors; a stuck window that does not end before it starts.
         for (name, sensor) in [
