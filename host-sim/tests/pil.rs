@@ -14,7 +14,7 @@
 //! `TSS_PIL_REQUIRED=1` (set by `scripts/test` and `scripts/pil-test`), which makes a missing
 //! prerequisite a failure. The ELF is not rebuilt here: `scripts/pil-test` builds it first.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use tss_reel::controller::{Controller, Input, Output};
@@ -76,7 +76,7 @@ fn scenario(overrides: &[&str]) -> Scenario {
     Scenario::load(root().join("scenarios/paper.toml"), &sets).unwrap()
 }
 
-fn run_pil(sc: &Scenario, elf: &PathBuf, name: &str) -> (History, PilReport) {
+fn run_pil(sc: &Scenario, elf: &Path, name: &str) -> (History, PilReport) {
     let dir = std::env::temp_dir().join(format!("tss-pil-test-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let log = dir.join("firmware.log");
