@@ -508,8 +508,8 @@ impl<T: Real> Controller<T> {
 
     /// Eqs. 27 + 29 solved implicitly, and the Eq. 30 acceleration (SPEC §5).
     fn solve(&self, x: &Input<T>, reference: &Reference<T>) -> Result<LawPart<T>, LawFault> {
-        let mass = self.cfg.masses;
         let l = x.length_m;
+        let (mu3, mu3_per_m) = self.cfg.masses.mu3_and_slope(l);
         let law_in = LawInput {
             length_m: l,
             alpha_rad: x.alpha_rad,
@@ -519,8 +519,8 @@ impl<T: Real> Controller<T> {
             ref_slope_rad_per_m: reference.angle.slope_rad_per_m,
             ref_curvature_rad_per_m2: reference.angle.curvature_rad_per_m2,
             ref_time_rate_radps: reference.time_rate_radps,
-            mu3: mass.coefficients(l).mu3,
-            mu3_per_m: mass.mu3_rate_per_s(l, T::ONE),
+            mu3,
+            mu3_per_m,
             blend_weight: self.blend_weight(x.tick),
             decay_rate_per_s: self.decay_rate_per_s(),
             initial_rate_mps: self.blend_initial_rate_mps,
@@ -619,7 +619,7 @@ impl<T: Real> Controller<T> {
 
     /// The Eq. 13 margin of the command (whole orbit), flagging a command outside the region.
     fn equilibrium_margin(&self, length_m: T, rate_mps: T, flags: &mut Flags) -> T {
-        let mu3 = self.cfg.masses.coefficients(length_m).mu3;
+        let mu3 = self.cfg.masses.mu3_and_slope(length_m).0;
         match self
             .existence
             .check_rate(Anomaly::WholeOrbit, mu3, length_m, rate_mps)

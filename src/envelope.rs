@@ -80,8 +80,23 @@ impl<T: Real> Envelope<T> {
         let guard = T::from_f64(LENGTH_GUARD_REL);
         let up_room = (self.max_length_m * (T::ONE - guard) - length_m).max(T::ZERO);
         let down_room = (length_m - self.min_length_m * (T::ONE + guard)).max(T::ZERO);
-        let up = self.braking_speed(up_room, dt_s);
-        let down = -self.braking_speed(down_room, dt_s);
+        // The staircase (two square roots) only matters near a limit: a speed v toward it is
+        // always allowed while the room exceeds v²/(2a) + 2vΔt, a bound on the distance the
+        // staircase needs to stop from v (it needs at most v²/(2a) + vΔt).
+        let two = T::from_f64(2.0);
+        let far = |v: T, room: T| v * (v / (two * self.max_accel_mps2) + two * dt_s) <= room;
+        let clear_up = y <= T::ZERO || far(y, up_room);
+        let clear_down = y >= T::ZERO || far(-y, down_room);
+        let up = if clear_up {
+            vmax
+        } else {
+            self.braking_speed(up_room, dt_s)
+        };
+        let down = if clear_down {
+            -vmax
+        } else {
+            -self.braking_speed(down_room, dt_s)
+        };
         if y > up || y < down {
             sat.length = true;
             y = y.clamp_to(down, up);

@@ -142,17 +142,24 @@ where
     O: OrbitRateSource,
     R: ReelDrive,
 {
-    let sample = dev.length.read_length_m(tick).map_err(|e| e.kind()).and_then(|length_m| {
-        let swing = dev.swing.read_swing(tick).map_err(|e| e.kind())?;
-        let n = dev.orbit.read_orbit_rate_radps(tick).map_err(|e| e.kind())?;
-        Ok(Input {
-            tick,
-            length_m,
-            alpha_rad: swing.alpha_rad,
-            alpha_rate_radps: swing.alpha_rate_radps,
-            orbit_rate_radps: n,
-        })
-    });
+    let sample = dev
+        .length
+        .read_length_m(tick)
+        .map_err(|e| e.kind())
+        .and_then(|length_m| {
+            let swing = dev.swing.read_swing(tick).map_err(|e| e.kind())?;
+            let n = dev
+                .orbit
+                .read_orbit_rate_radps(tick)
+                .map_err(|e| e.kind())?;
+            Ok(Input {
+                tick,
+                length_m,
+                alpha_rad: swing.alpha_rad,
+                alpha_rate_radps: swing.alpha_rate_radps,
+                orbit_rate_radps: n,
+            })
+        });
     let (output, sensor_error) = match sample {
         Ok(input) => (controller.step(&input), None),
         Err(kind) => (controller.step_missing(tick), Some(kind)),

@@ -71,6 +71,18 @@ impl<T: Real> MassModel<T> {
         }
     }
 
+    /// (μ3, dμ3/dl) at `length_m`: what the law needs, from one evaluation of the
+    /// coefficients (both 0 for a massless tether, without any arithmetic).
+    pub fn mu3_and_slope(&self, length_m: T) -> (T, T) {
+        if self.tether_density_kg_per_m == T::ZERO {
+            return (T::ZERO, T::ZERO);
+        }
+        (
+            self.coefficients(length_m).mu3,
+            self.mu3_rate_per_s(length_m, T::ONE),
+        )
+    }
+
     /// μ̇3 = ρ l̇ [−m01(m2 + m_t/2)² + ⅓M(m01 m2 + m_t²/2)]/(M M*)², 1/s (the paper's
     /// expression after Eq. 30; SPEC §1). Zero for a massless tether.
     pub fn mu3_rate_per_s(&self, length_m: T, length_rate_mps: T) -> T {
@@ -129,10 +141,20 @@ mod tests {
         let m = thin_tether();
         for &l in &[10.0, 2_000.0, 30_000.0, 100_000.0] {
             let h = 1e-3 * l;
-            let d = (m.coefficients(l + h).reduced_kg - m.coefficients(l - h).reduced_kg) / (2.0 * h);
+            let d =
+                (m.coefficients(l + h).reduced_kg - m.coefficients(l - h).reduced_kg) / (2.0 * h);
             let c = m.coefficients(l);
             assert!((c.mu3 - l * d / c.reduced_kg).abs() < 1e-8, "l = {l}");
         }
+    }
+
+    #[test]
+    fn mu3_and_slope_is_mu3_and_its_length_derivative() {
+        let m = thin_tether();
+        let (mu3, slope) = m.mu3_and_slope(12_000.0);
+        assert_eq!(mu3, m.coefficients(12_000.0).mu3);
+        assert_eq!(slope, m.mu3_rate_per_s(12_000.0, 1.0));
+        assert_eq!(MassModel::<f64>::paper().mu3_and_slope(12_000.0), (0.0, 0.0));
     }
 
     #[test]
@@ -141,6 +163,10 @@ mod tests {
         let (l, ld) = (12_000.0, 1.7);
         let h = 1e-2;
         let fd = (m.coefficients(l + h).mu3 - m.coefficients(l - h).mu3) / (2.0 * h) * ld;
-        assert!((m.mu3_rate_per_s(l, ld) - fd).abs() < 1e-12, "{} vs {fd}", m.mu3_rate_per_s(l, ld));
+        assert!(
+            (m.mu3_rate_per_s(l, ld) - fd).abs() < 1e-12,
+            "{} vs {fd}",
+            m.mu3_rate_per_s(l, ld)
+        );
     }
 }

@@ -119,6 +119,9 @@ mod tests {
         let h = 1e-6;
         let d = (o.true_anomaly_rate_radps(th + h) - o.true_anomaly_rate_radps(th - h)) / (2.0 * h);
         let fd = d * o.true_anomaly_rate_radps(th);
-        assert!((o.true_anomaly_accel_radps2(th) - fd).abs() < 1e-6 * fd.abs(), "{fd}");
+        assert!(
+            (o.true_anomaly_accel_radps2(th) - fd).abs() < 1e-6 * fd.abs(),
+            "{fd}"
+        );
     }
 }

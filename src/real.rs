@@ -129,7 +129,7 @@ impl Real for f32 {
     }
     #[inline]
     fn sqrt(self) -> Self {
-        libm::sqrtf(self)
+        crate::fastmath::sqrt(self)
     }
     #[inline]
     fn abs(self) -> Self {

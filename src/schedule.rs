@@ -45,45 +45,6 @@ pub struct BandSchedule<T> {
     pub high_slope_rad_per_m: T,
 }
 
-/// Quintic Hermite basis at s ∈ [0, 1]: values, first and second derivatives of
-/// (H0, H1, H4, H5) (SPEC §6). H0/H5 carry the end values, H1/H4 the end slopes; all
-/// second derivatives vanish at both ends.
-struct Hermite5<T> {
-    h: [T; 4],
-    d1: [T; 4],
-    d2: [T; 4],
-}
-
-impl<T: Real> Hermite5<T> {
-    fn at(s: T) -> Self {
-        let c = |x: f64| T::from_f64(x);
-        let s2 = s * s;
-        let s3 = s2 * s;
-        let s4 = s3 * s;
-        let s5 = s4 * s;
-        Self {
-            h: [
-                T::ONE - c(10.0) * s3 + c(15.0) * s4 - c(6.0) * s5,
-                s - c(6.0) * s3 + c(8.0) * s4 - c(3.0) * s5,
-                -c(4.0) * s3 + c(7.0) * s4 - c(3.0) * s5,
-                c(10.0) * s3 - c(15.0) * s4 + c(6.0) * s5,
-            ],
-            d1: [
-                -c(30.0) * s2 + c(60.0) * s3 - c(30.0) * s4,
-                T::ONE - c(18.0) * s2 + c(32.0) * s3 - c(15.0) * s4,
-                -c(12.0) * s2 + c(28.0) * s3 - c(15.0) * s4,
-                c(30.0) * s2 - c(60.0) * s3 + c(30.0) * s4,
-            ],
-            d2: [
-                -c(60.0) * s + c(180.0) * s2 - c(120.0) * s3,
-                -c(36.0) * s + c(96.0) * s2 - c(60.0) * s3,
-                -c(24.0) * s + c(84.0) * s2 - c(60.0) * s3,
-                c(60.0) * s - c(180.0) * s2 + c(120.0) * s3,
-            ],
-        }
-    }
-}
-
 impl<T: Real> BandSchedule<T> {
     /// Eq. 34 with the paper's numbers: −π/4 up to 10 km, a transition to 0 at 30 km, then
     /// k(l − 30 km) with k = π·10⁻⁵ rad/m.
@@ -132,21 +93,49 @@ impl<T: Real> BandSchedule<T> {
                 curvature_rad_per_m2: T::ZERO,
             };
         }
-        // Transition band: f = f_a H0 + h f'_a H1 + h f'_b H4 + f_b H5 (SPEC §6).
+        // Transition band: the quintic with f″ = 0 at both ends (SPEC §6), written around the
+        // nearer end of the band: f = f_e + h f'_e u + u³(c3 + u(c4 + u c5)) with u the
+        // distance from that end in band widths, so that near an end (station keeping sits at
+        // them) f32 keeps the precision of the straight piece instead of losing ~1e-6 rad to
+        // cancellation among the Hermite basis functions.
         let h = self.high_length_m - self.low_length_m;
-        let s = (length_m - self.low_length_m) / h;
-        let b = Hermite5::at(s);
-        let coef = [
-            self.low_angle_rad,
-            h * self.low_slope_rad_per_m,
-            h * self.high_slope_rad_per_m,
-            self.high_angle_rad,
-        ];
-        let dot = |w: &[T; 4]| coef[0] * w[0] + coef[1] * w[1] + coef[2] * w[2] + coef[3] * w[3];
+        let half = T::from_f64(0.5);
+        let from_low = (length_m - self.low_length_m) / h;
+        let (u, sign, f_end, k_end, f_far, k_far) = if from_low <= half {
+            (
+                from_low,
+                T::ONE,
+                self.low_angle_rad,
+                self.low_slope_rad_per_m,
+                self.high_angle_rad,
+                self.high_slope_rad_per_m,
+            )
+        } else {
+            (
+                (self.high_length_m - length_m) / h,
+                -T::ONE,
+                self.high_angle_rad,
+                self.high_slope_rad_per_m,
+                self.low_angle_rad,
+                self.low_slope_rad_per_m,
+            )
+        };
+        // In the variable u (du/dl = sign/h): g(0) = f_e, g'(0) = sign·h·k_e, g'(1) = sign·h·k_far.
+        let g1 = sign * h * k_end;
+        let delta = f_far - f_end - g1;
+        let d = sign * h * (k_far - k_end);
+        let c = |x: f64| T::from_f64(x);
+        let c3 = c(10.0) * delta - c(4.0) * d;
+        let c4 = c(-15.0) * delta + c(7.0) * d;
+        let c5 = c(6.0) * delta - c(3.0) * d;
+        let u2 = u * u;
+        let g = f_end + g1 * u + u2 * u * (c3 + u * (c4 + u * c5));
+        let g_u = g1 + u2 * (c(3.0) * c3 + u * (c(4.0) * c4 + u * c(5.0) * c5));
+        let g_uu = u * (c(6.0) * c3 + u * (c(12.0) * c4 + u * c(20.0) * c5));
         RefAngle {
-            angle_rad: dot(&b.h),
-            slope_rad_per_m: dot(&b.d1) / h,
-            curvature_rad_per_m2: dot(&b.d2) / (h * h),
+            angle_rad: g,
+            slope_rad_per_m: sign * g_u / h,
+            curvature_rad_per_m2: g_uu / (h * h),
         }
     }
 }

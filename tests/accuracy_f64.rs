@@ -236,15 +236,15 @@ fn whole_mission_f32_vs_f64() {
     let f = compare(mission::TICKS, mission::ORBIT_RATE_RADPS, mission::sample);
     f.print("paper mission (20 h)");
     assert_eq!(f.state_mismatches, 0);
-    // The goal is met on most of the mission (median 5e-8) but not everywhere: at station
-    // keeping near 30 km (and on the stage-2 band) the f32 reference schedule loses up to
-    // 1e-6 rad to cancellation in the quintic Hermite basis near the band's ends, which the
-    // law's gain turns into ~3e-5 m/s, 2.6e-2 of a 1 mm/s command. These bounds hold what is
-    // measured today (with margin), so a regression shows; tighten them when it is fixed.
-    assert!(f.worst.rel <= 5e-2, "{:?}", f.worst);
-    assert!(f.worst.abs_mps <= 1e-4, "{:?}", f.worst);
+    // The goal holds on all but a handful of steps (measured: median 2.7e-8, max 5.8e-5, 11 of
+    // 72 001 steps above 1e-5, all in the first seconds after the stage-2 blend restart, where
+    // l̇0 is the last f32 command and the Eq. 27 value it blends toward is large). The quintic
+    // transitions are evaluated from the nearer band end (src/schedule.rs), which removed the
+    // f32 cancellation that used to cost 2.6e-2 at the keep phases. Bounds with margin:
+    assert!(f.worst.rel <= 2e-4, "{:?}", f.worst);
+    assert!(f.worst.abs_mps <= 1e-5, "{:?}", f.worst);
     assert!(
-        f.above_goal() * 100 <= f.rels.len() * 15,
+        f.above_goal() * 1000 <= f.rels.len(),
         "{} of {} steps above {GOAL:e}",
         f.above_goal(),
         f.rels.len()
