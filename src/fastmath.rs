@@ -60,7 +60,7 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
 /// normal positive x; zero, subnormals, infinities, negatives and NaN go to libm.
 #[inline]
 pub fn sqrt(x: f32) -> f32 {
-    let normal = x >= f32::MIN_POSITIVE && x <= f32::MAX;
+    let normal = (f32::MIN_POSITIVE..=f32::MAX).contains(&x);
     if !normal {
         return libm::sqrtf(x);
     }
