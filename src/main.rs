@@ -43,6 +43,8 @@ fn main() {}
 #[cortex_m_rt::entry]
 fn main() -> ! {
     use firmware::{clock::ControlClock, exit, mission};
+    // Fill the unused stack with a pattern, so the high-water mark can be read at the end.
+    firmware::stack::paint();
 
     defmt::info!(
         "tss-reel firmware {=str}: control period {=u32} ms",
@@ -71,6 +73,7 @@ fn main() -> ! {
                     tick + 1,
                     clock.overruns()
                 );
+                firmware::stack::log_high_water();
                 exit::success();
             }
             mission::Flow::Failed => {

@@ -13,7 +13,7 @@
 //! blend crossing zero) is measured against 1 mm/s: a relative error of a near-zero command is
 //! not meaningful, and 1 mm/s is below what a reel encoder resolves in one period.
 //!
-//! The sequences: the firmware's replay (`src/firmware/replay_data.rs`, 900 s with its sensor
+//! The sequences: the firmware's replay (`src/firmware/replay_data.rs`, 720 s with its sensor
 //! dropout), the whole 20-hour paper mission (`examples/bench_step/mission.rs`, interpolated to
 //! 1 s), and random states across the range the sensor checks accept. Each test prints its
 //! figures (`cargo test --test accuracy_f64 -- --nocapture`).
@@ -225,7 +225,7 @@ fn firmware_replay_f32_vs_f64() {
             }
         },
     );
-    f.print("firmware replay (900 s)");
+    f.print("firmware replay (720 s)");
     assert_eq!(f.state_mismatches, 0);
     // Deployment below 26 km: the goal holds at every step.
     assert!(f.worst.rel <= GOAL, "{:?}", f.worst);

@@ -1,7 +1,7 @@
 //! What the firmware does on each control tick: the reel controller flying a recorded stretch
 //! of the paper's mission.
 //!
-//! The built-in test input ([`super::replay_data`]) is the first 900 s of `scenarios/paper.toml`
+//! The built-in test input ([`super::replay_data`]) is the first 720 s of `scenarios/paper.toml`
 //! as the reel MCU senses it, recorded from `tss-sim`, with a sensor dropout injected at ticks
 //! 400..450 (longer than the controller's 30-tick coast, so it goes Degraded → SafeHold and
 //! recovers). The replay implements the [`tss_reel::hal`] sensor traits; the reel drive is a

@@ -17,4 +17,5 @@ pub mod exit;
 pub mod mission;
 pub mod pil;
 pub mod replay_data;
+pub mod stack;
 pub mod uart;
