@@ -14,15 +14,19 @@ fn scenario() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper-montecarlo.toml")
 }
 
-/// Overrides that shorten the mission to its first 10 minutes, with the station-keeping and
-/// final-length criteria switched off (neither is reached).
-const SHORT: [&str; 6] = [
+/// Overrides that shorten the mission to its first 10 minutes, with the criteria on what happens
+/// later (reaching 30 km, overshoot, station keeping, final length) switched off.
+const SHORT: [&str; 10] = [
     "--set",
     "simulation.duration_s=600",
     "--set",
     "montecarlo.criteria.max_keep1_error_m=inf",
     "--set",
     "montecarlo.criteria.max_final_error_m=inf",
+    "--set",
+    "montecarlo.criteria.max_time_to_keep1_s=inf",
+    "--set",
+    "montecarlo.criteria.max_overshoot_m=inf",
 ];
 
 fn tss_sim(args: &[&str]) -> Output {
