@@ -10,12 +10,17 @@ use tss_reel::link::{
     Report, Sample, DELIMITER, MAX_WIRE_LEN, SAMPLE_MISSING,
 };
 
-/// Cases per property: the issue asks for at least 100 000 on the decoder.
+/// Cases per property: the issue asks for at least 100 000 on the decoder. `TSS_LINK_CASES`
+/// asks for more (a longer fuzzing run by hand).
 const CASES: u32 = 100_000;
 
 fn config() -> ProptestConfig {
+    let cases = std::env::var("TSS_LINK_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .map_or(CASES, |n: u32| n.max(CASES));
     ProptestConfig {
-        cases: CASES,
+        cases,
         failure_persistence: None,
         ..ProptestConfig::default()
     }
