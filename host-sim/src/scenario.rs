@@ -995,9 +995,9 @@ impl Scenario {
             let sum = l.drop_prob + l.corrupt_prob + l.duplicate_prob + l.reorder_prob;
             v.check(
                 sum <= 1.0,
-                "link.reorder_prob",
-                num(l.reorder_prob),
-                &format!("makes the link's fault probabilities add up to {} (at most 1)", num(sum)),
+                "link.drop_prob + link.corrupt_prob + link.duplicate_prob + link.reorder_prob",
+                num(sum),
+                "must be at most 1 (each frame meets at most one fault)",
             );
         }
         v.problems
