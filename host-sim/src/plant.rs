@@ -140,11 +140,46 @@ impl Plant {
     pub fn rk4_step_varying(&self, x: &State, rates_mps: [f64; 3], h_s: f64) -> State {
         let [v0, v1, v2] = rates_mps;
         let f = self.frozen();
+        if x[ix::BETA] == 0.0 && x[ix::BETA_RATE] == 0.0 {
+            return self.rk4_in_plane(&f, x, rates_mps, h_s);
+        }
         let k1 = self.derivative_with(&f, x, v0);
         let k2 = self.derivative_with(&f, &(x + k1 * (0.5 * h_s)), v1);
         let k3 = self.derivative_with(&f, &(x + k2 * (0.5 * h_s)), v1);
         let k4 = self.derivative_with(&f, &(x + k3 * h_s), v2);
         x + (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h_s / 6.0)
+    }
+
+    /// [`Plant::rk4_step_varying`] from a state in the orbit plane (β = β̇ = 0, which every
+    /// stage keeps: the β rows of the derivative are 0), on the four in-plane components only.
+    /// Each component goes through the general step's operations in the same order, so the
+    /// result is the same bit for bit (β and β̇ end at +0, as 0 + 0 does).
+    fn rk4_in_plane(&self, f: &Frozen, x: &State, [v0, v1, v2]: [f64; 3], h_s: f64) -> State {
+        // (θ̇, l̇, α̇, α̈) at (θ, l, α, α̇) with the reel at `v`: Eq. 5b in the plane.
+        let d = |y: [f64; 4], v: f64| -> [f64; 4] {
+            let (theta_rate, theta_accel, gg) = self.orbit_terms(f, y[0]);
+            let mu3 = self.mass_terms(f, y[1]).mu3;
+            let spin = theta_rate + y[3];
+            let stretch = (2.0 + mu3) * v / y[1];
+            let alpha_accel = -spin * stretch - 1.5 * gg * (2.0 * y[2]).sin() - theta_accel;
+            [theta_rate, v, y[3], alpha_accel]
+        };
+        let stage = |k: [f64; 4], c: f64| -> [f64; 4] {
+            [
+                x[0] + k[0] * c,
+                x[1] + k[1] * c,
+                x[2] + k[2] * c,
+                x[3] + k[3] * c,
+            ]
+        };
+        let y0 = [x[0], x[1], x[2], x[3]];
+        let k1 = d(y0, v0);
+        let k2 = d(stage(k1, 0.5 * h_s), v1);
+        let k3 = d(stage(k2, 0.5 * h_s), v1);
+        let k4 = d(stage(k3, h_s), v2);
+        let c = h_s / 6.0;
+        let next = |i: usize| x[i] + (k1[i] + k2[i] * 2.0 + k3[i] * 2.0 + k4[i]) * c;
+        State::from([next(0), next(1), next(2), next(3), 0.0, 0.0])
     }
 
     /// The orbit rate θ̇ at true anomaly θ, rad/s (n on a circular orbit, without evaluating
