@@ -80,6 +80,8 @@ impl Reel {
             } else {
                 knee * (-(t_s - t_ramp) / tau).exp()
             }
+        } else if t_s == 0.0 {
+            d0.abs() // e^(−0/τ) = 1 exactly: the start of a period needs no exponential
         } else {
             d0.abs() * (-t_s / tau).exp()
         };
@@ -174,6 +176,17 @@ mod tests {
         assert_eq!(r.accel_after(-1.0, 5.0), -0.1);
         assert_eq!(r.rate_after(-1.0, 25.0), -1.0);
         assert_eq!(r.accel_after(-1.0, 25.0), 0.0);
+    }
+
+    #[test]
+    fn at_the_start_of_a_period_the_rate_is_the_exponential_at_zero() {
+        for (lag, rate, command) in [(0.5, 0.3, 2.0), (2.0, -1.0, -1.5), (1.0, 4.0, 3.999)] {
+            let r = reel(lag, f64::INFINITY, f64::INFINITY, rate);
+            let g = r.target_mps(command);
+            let d0 = g - r.rate_mps;
+            let expect = g - d0.signum() * (d0.abs() * (-0.0 / lag).exp());
+            assert_eq!(r.rate_after(command, 0.0).to_bits(), expect.to_bits());
+        }
     }
 
     #[test]
