@@ -154,7 +154,10 @@ mod tests {
         let (mu3, slope) = m.mu3_and_slope(12_000.0);
         assert_eq!(mu3, m.coefficients(12_000.0).mu3);
         assert_eq!(slope, m.mu3_rate_per_s(12_000.0, 1.0));
-        assert_eq!(MassModel::<f64>::paper().mu3_and_slope(12_000.0), (0.0, 0.0));
+        assert_eq!(
+            MassModel::<f64>::paper().mu3_and_slope(12_000.0),
+            (0.0, 0.0)
+        );
     }
 
     #[test]

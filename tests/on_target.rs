@@ -190,7 +190,15 @@ mod tests {
         use tss_reel::controller::{Config, Controller, Input};
         let cfg = Config::<f32>::paper();
         let mut ctl = defmt::unwrap!(Controller::new(cfg).ok());
-        let junk = [f32::NAN, f32::INFINITY, -f32::INFINITY, 1e-40, -1.0, 3.0e38, 0.0];
+        let junk = [
+            f32::NAN,
+            f32::INFINITY,
+            -f32::INFINITY,
+            1e-40,
+            -1.0,
+            3.0e38,
+            0.0,
+        ];
         let mut tick = 0;
         for &a in &junk {
             for &b in &junk {

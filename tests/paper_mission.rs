@@ -48,7 +48,12 @@ fn stage1_table1_lengths_within_6_cm_of_the_paper() {
         if p.stage == 1 {
             let d = l - p.length_m;
             worst = worst.max(d.abs());
-            assert!(d.abs() <= 0.06, "t = {} h: simulated {l:.4} m, paper {} m", p.t_h, p.length_m);
+            assert!(
+                d.abs() <= 0.06,
+                "t = {} h: simulated {l:.4} m, paper {} m",
+                p.t_h,
+                p.length_m
+            );
         }
     }
     eprintln!("stage-1 Table 1: largest |difference| {worst:.4} m");
@@ -60,7 +65,11 @@ fn stage2_table1_settles_on_2_km_below_the_papers_offset() {
     // implementation settles at 2000 m. Ours is below the paper at every instant, above 2 km,
     // and decreasing, like the paper's column.
     let h = paper();
-    let stage2: Vec<_> = PAPER_TABLE1.iter().zip(&h.probes).filter(|(p, _)| p.stage == 2).collect();
+    let stage2: Vec<_> = PAPER_TABLE1
+        .iter()
+        .zip(&h.probes)
+        .filter(|(p, _)| p.stage == 2)
+        .collect();
     assert_eq!(stage2.len(), 21);
     let mut prev = f64::INFINITY;
     for (p, (_, l)) in &stage2 {
@@ -90,11 +99,23 @@ fn retrieval_is_monotone_toward_2_km() {
         .expect("retrieval begins");
     let tail = &h.samples[start..];
     for w in tail.windows(2) {
-        assert!(w[1].length_m <= w[0].length_m + 1e-6, "l rises at t = {} s", w[1].t_s);
-        assert!(w[1].length_m > 2000.0 - 1e-3, "below 2 km at t = {} s", w[1].t_s);
+        assert!(
+            w[1].length_m <= w[0].length_m + 1e-6,
+            "l rises at t = {} s",
+            w[1].t_s
+        );
+        assert!(
+            w[1].length_m > 2000.0 - 1e-3,
+            "below 2 km at t = {} s",
+            w[1].t_s
+        );
     }
     let last = h.samples.last().unwrap();
-    assert!((last.length_m - 2000.0).abs() < 0.01, "final length {}", last.length_m);
+    assert!(
+        (last.length_m - 2000.0).abs() < 0.01,
+        "final length {}",
+        last.length_m
+    );
 }
 
 #[test]
@@ -104,34 +125,50 @@ fn alpha_follows_minus_45_degrees_in_early_deployment() {
     // once the law dominates, α settles on α_r = −45° and stays there until the band starts
     // at 10 km (≈ 2.5 h).
     let h = paper();
-    let early_min = between(h, 0.0, 1.0).map(|s| s.alpha_rad.to_degrees()).fold(0.0, f64::min);
-    assert!((-80.0..-60.0).contains(&early_min), "early swing to {early_min}°");
+    let early_min = between(h, 0.0, 1.0)
+        .map(|s| s.alpha_rad.to_degrees())
+        .fold(0.0, f64::min);
+    assert!(
+        (-80.0..-60.0).contains(&early_min),
+        "early swing to {early_min}°"
+    );
     let samples: Vec<_> = between(h, 1.0, 2.5).collect();
     assert!(samples.iter().all(|s| s.length_m < 10_000.0));
     let worst = samples
         .iter()
         .map(|s| (s.alpha_rad.to_degrees() + 45.0).abs())
         .fold(0.0, f64::max);
-    assert!(worst < 1.0, "largest |α + 45°| from 1 h to 2.5 h = {worst}°");
+    assert!(
+        worst < 1.0,
+        "largest |α + 45°| from 1 h to 2.5 h = {worst}°"
+    );
 }
 
 #[test]
 fn milestones_match_the_papers_description() {
     // SPEC §7: 10 km near 2.5 h, 30 km near 3.3 h with an overshoot.
     let h = paper();
-    let first = |pred: &dyn Fn(&Sample) -> bool| h.samples.iter().find(|s| pred(s)).map(|s| s.t_s / 3600.0);
+    let first =
+        |pred: &dyn Fn(&Sample) -> bool| h.samples.iter().find(|s| pred(s)).map(|s| s.t_s / 3600.0);
     let t10 = first(&|s| s.length_m >= 10_000.0).unwrap();
     let t30 = first(&|s| s.length_m >= 30_000.0).unwrap();
     assert!((2.2..2.8).contains(&t10), "10 km at {t10} h");
     assert!((3.0..3.6).contains(&t30), "30 km at {t30} h");
     let overshoot = between(h, 0.0, 8.0).map(|s| s.length_m).fold(0.0, f64::max) - 30_000.0;
-    assert!(overshoot > 0.0 && overshoot < 3_000.0, "overshoot {overshoot} m");
+    assert!(
+        overshoot > 0.0 && overshoot < 3_000.0,
+        "overshoot {overshoot} m"
+    );
 }
 
 #[test]
 fn tension_stays_positive_throughout() {
     for h in [paper(), massive_tether()] {
-        let min = h.samples.iter().map(|s| s.tension_n).fold(f64::INFINITY, f64::min);
+        let min = h
+            .samples
+            .iter()
+            .map(|s| s.tension_n)
+            .fold(f64::INFINITY, f64::min);
         assert!(min > 0.0, "slack tether: min tension {min} N");
     }
 }
@@ -144,7 +181,10 @@ fn phases_occur_in_order_without_faults_or_saturation() {
         if *seen.last().unwrap() != s.phase {
             seen.push(s.phase);
         }
-        let bad = Flags::RATE_SATURATED | Flags::ACCEL_SATURATED | Flags::LENGTH_LIMITED | Flags::SAFE_ACTION;
+        let bad = Flags::RATE_SATURATED
+            | Flags::ACCEL_SATURATED
+            | Flags::LENGTH_LIMITED
+            | Flags::SAFE_ACTION;
         assert_eq!(s.flags & bad, 0, "flags {:#b} at t = {} s", s.flags, s.t_s);
     }
     use PhaseLabel::*;
@@ -155,20 +195,38 @@ fn phases_occur_in_order_without_faults_or_saturation() {
 fn massive_tether_mission_is_well_behaved() {
     // ρ = 1e-3 kg/m: 40 kg of tether at 40 km, μ1, μ3 ≠ 0 and μ2 < 1 (SPEC §1).
     let h = massive_tether();
-    let keep = between(h, 7.0, 8.0).map(|s| (s.length_m - 30_000.0).abs()).fold(0.0, f64::max);
+    let keep = between(h, 7.0, 8.0)
+        .map(|s| (s.length_m - 30_000.0).abs())
+        .fold(0.0, f64::max);
     assert!(keep < 0.5, "station keeping within {keep} m");
     let last = h.samples.last().unwrap();
-    assert!((last.length_m - 2000.0).abs() < 0.05, "final length {}", last.length_m);
+    assert!(
+        (last.length_m - 2000.0).abs() < 0.05,
+        "final length {}",
+        last.length_m
+    );
     assert!(h.samples.iter().all(|s| s.flags & Flags::SAFE_ACTION == 0));
     // The same early swing as the massless run (the tether weighs grams then), never past 80°.
-    let max_abs_alpha = h.samples.iter().map(|s| s.alpha_rad.abs()).fold(0.0, f64::max);
-    assert!(max_abs_alpha.to_degrees() < 80.0, "max |α| {}°", max_abs_alpha.to_degrees());
+    let max_abs_alpha = h
+        .samples
+        .iter()
+        .map(|s| s.alpha_rad.abs())
+        .fold(0.0, f64::max);
+    assert!(
+        max_abs_alpha.to_degrees() < 80.0,
+        "max |α| {}°",
+        max_abs_alpha.to_degrees()
+    );
     // Outside the stage-2 slew (α lags the 500 s ramp of α_r by up to 13°), δ stays small.
     let tracking = between(h, 1.5, 8.0)
         .chain(between(h, 9.0, 20.0))
         .map(|s| s.delta_rad.abs())
         .fold(0.0, f64::max);
-    assert!(tracking.to_degrees() < 5.0, "max |δ| off the slew: {}°", tracking.to_degrees());
+    assert!(
+        tracking.to_degrees() < 5.0,
+        "max |δ| off the slew: {}°",
+        tracking.to_degrees()
+    );
 }
 
 #[test]

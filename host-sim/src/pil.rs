@@ -370,7 +370,10 @@ impl PilLink {
             // the firmware does not use and which has no network here.
             std::thread::spawn(move || {
                 use std::io::BufRead as _;
-                for line in std::io::BufReader::new(stderr).lines().map_while(Result::ok) {
+                for line in std::io::BufReader::new(stderr)
+                    .lines()
+                    .map_while(Result::ok)
+                {
                     if !line.contains("lan9118.0 has no peer") {
                         eprintln!("{line}");
                     }
