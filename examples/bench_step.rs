@@ -30,12 +30,11 @@
 //! ## The parts of a step
 //!
 //! On a step where the law ran (health `Nominal`), the public pieces the controller calls are
-//! timed separately, with the step's own arguments: the reference schedule (`BandSchedule::eval`
-//! or the stage-2 `SlewedSchedule::eval`), the implicit law (`law::solve`) and its acceleration
-//! (`law::acceleration`), the blend (`libm::expf`, which the step calls twice: once for the law,
-//! once for the output), the mass model (`MassModel::coefficients` twice and
-//! `MassModel::mu3_rate_per_s`, which calls it again), the equilibrium-existence check
-//! (`ExistenceMonitor::check_rate`) and the envelope (`Envelope::limit`). What is left of the
+//! timed separately, with the step's own arguments: the reference schedule (`PreparedBand::eval`
+//! or the stage-2 `PreparedBand::eval_slewed`), the implicit law (`law::solve`) and its
+//! acceleration (`law::acceleration`), the blend weight (`fastmath::exp`, once a step), the mass
+//! model (`MassModel::mu3_and_slope`), the equilibrium-existence margin
+//! (`ExistenceMonitor::whole_orbit_margin`) and the envelope (`Envelope::limit`). What is left of the
 //! step is the sensor validation (the monitor's checks), the sequencer and health state machine,
 //! dead reckoning and filling in the output.
 //!
@@ -75,9 +74,9 @@ mod bench {
     use core::hint::black_box;
     use cortex_m::peripheral::{syst::SystClkSource, SYST};
     use tss_reel::controller::{Config, Controller, Health, Input, Output, Phase};
-    use tss_reel::equilibrium::{Anomaly, ExistenceMonitor};
+    use tss_reel::equilibrium::ExistenceMonitor;
     use tss_reel::law::{self, LawInput};
-    use tss_reel::schedule::{Reference, SlewedSchedule};
+    use tss_reel::schedule::{PreparedBand, Reference};
 
     /// Copies of the state each measurement runs on; the result is divided by this.
     pub const K: usize = 16;
@@ -257,11 +256,11 @@ mod bench {
         LawSolve,
         /// `law::acceleration`: Eq. 30.
         LawAccel,
-        /// The Eq. 29 blend weight e^{−cτ}, `libm::expf`, twice per step.
+        /// The Eq. 29 blend weight e^{−cτ}: `fastmath::exp`, once per step.
         BlendExp,
-        /// μ3 and dμ3/dl: `MassModel::coefficients` ×2 and `mu3_rate_per_s` (which calls it).
+        /// μ3 and dμ3/dl: `MassModel::mu3_and_slope` (one comparison for a massless tether).
         MassModel,
-        /// Eq. 13 existence margin: `ExistenceMonitor::check_rate`.
+        /// Eq. 13 existence margin: `ExistenceMonitor::whole_orbit_margin`.
         Existence,
         /// Rate/acceleration/length limits: `Envelope::limit` (with two √).
         Envelope,
@@ -337,6 +336,7 @@ mod bench {
         m: &Meter,
         cfg: &Config<f32>,
         existence: &ExistenceMonitor<f32>,
+        bands: &(PreparedBand<f32>, PreparedBand<f32>),
         x: &Input<f32>,
         out: &Output<f32>,
         previous_rate_mps: f32,
@@ -345,18 +345,15 @@ mod bench {
         let stage2 = matches!(out.phase, Phase::Slew | Phase::Retrieve | Phase::Keep2);
         let stage_start = if stage2 { stage2_start_tick(cfg) } else { 0 };
         let tau_s = x.tick.saturating_sub(stage_start) as f32 * cfg.period_s;
-        let slewed = SlewedSchedule {
-            schedule: cfg.stage2.schedule,
-            slew_rate_radps: cfg.stage2.slew_rate_radps,
-        };
-        let stage1 = cfg.stage1.schedule;
+        let (stage1, stage2_band) = bands;
+        let slew = cfg.stage2.slew_rate_radps;
         let schedule = if stage2 {
-            m.pure((tau_s, l), |&(t, l)| slewed.eval(t, l))
+            m.pure((tau_s, l), |&(t, l)| stage2_band.eval_slewed(slew, t, l))
         } else {
             m.pure(l, |&l| stage1.eval(l))
         };
         let reference = if stage2 {
-            slewed.eval(tau_s, l)
+            stage2_band.eval_slewed(slew, tau_s, l)
         } else {
             Reference {
                 angle: stage1.eval(l),
@@ -379,8 +376,8 @@ mod bench {
             ref_slope_rad_per_m: reference.angle.slope_rad_per_m,
             ref_curvature_rad_per_m2: reference.angle.curvature_rad_per_m2,
             ref_time_rate_radps: reference.time_rate_radps,
-            mu3: masses.coefficients(l).mu3,
-            mu3_per_m: masses.mu3_rate_per_s(l, 1.0),
+            mu3: masses.mu3_and_slope(l).0,
+            mu3_per_m: masses.mu3_and_slope(l).1,
             blend_weight: out.blend_weight,
             decay_rate_per_s: decay,
             initial_rate_mps: initial,
@@ -394,13 +391,12 @@ mod bench {
         };
         // The blend's argument −cτ, recovered from the reported weight.
         let exponent = libm::logf(out.blend_weight.max(f32::MIN_POSITIVE));
-        let blend = 2 * m.pure(exponent, |&e| libm::expf(e));
-        let mass = 2 * m.pure(l, |&l| masses.coefficients(l))
-            + m.pure(l, |&l| masses.mu3_rate_per_s(l, 1.0));
+        let blend = m.pure(exponent, |&e| tss_reel::fastmath::exp(e));
+        let mass = m.pure(l, |&l| masses.mu3_and_slope(l));
         let mu3 = law_in.mu3;
         let rate = out.rate_cmd_mps;
         let exist = m.pure((mu3, l, rate), |&(mu3, l, y)| {
-            existence.check_rate(Anomaly::WholeOrbit, mu3, l, y)
+            existence.whole_orbit_margin(mu3, l, y)
         });
         let env = cfg.envelope;
         let requested = solution.map(|s| s.rate_mps).unwrap_or(rate);
@@ -428,6 +424,7 @@ mod bench {
             defmt::error!("no existence monitor for the paper's orbit");
             crate::exit::failure();
         };
+        let bands = (cfg.stage1.schedule.prepare(), cfg.stage2.schedule.prepare());
         let mut previous_rate = cfg.initial_rate_mps;
         for tick in 0..ticks {
             let input = sample(tick).map(|s| Input {
@@ -458,7 +455,7 @@ mod bench {
                     previous_rate = out.rate_cmd_mps;
                     continue;
                 }
-                let parts = time_parts(m, &cfg, &existence, x, &out, previous_rate);
+                let parts = time_parts(m, &cfg, &existence, &bands, x, &out, previous_rate);
                 let mut sum = 0;
                 for (s, &v) in r.parts.iter_mut().zip(&parts) {
                     s.add(v, tick);
@@ -578,16 +575,18 @@ mod bench {
     /// Per-call instructions of the math primitives the step uses, at typical arguments.
     pub fn primitives(m: &Meter) {
         let sc = m.pure(-1.3_f32, |&x| tss_reel::fastmath::sin_cos(x));
+        let fexp = m.pure(-3.2_f32, |&x| tss_reel::fastmath::exp(x));
+        let fsqrt = m.pure(1.7e-7_f32, |&x| tss_reel::fastmath::sqrt(x));
         let exp = m.pure(-3.2_f32, |&x| libm::expf(x));
         let sqrt = m.pure(1.7e-7_f32, |&x| libm::sqrtf(x));
-        let rint = m.pure(-0.83_f32, |&x| libm::rintf(x));
         let div = m.pure((1.7e-7_f32, 3.1_f32), |&(a, b)| a / b);
         defmt::info!(
-            "primitives (instructions per call): fastmath::sin_cos {=u32}, libm::expf {=u32}, libm::sqrtf {=u32}, libm::rintf {=u32}, f32 division {=u32}",
+            "primitives (instructions per call): fastmath::sin_cos {=u32}, fastmath::exp {=u32}, fastmath::sqrt {=u32}; libm::expf {=u32}, libm::sqrtf {=u32}; f32 division {=u32}",
             sc,
+            fexp,
+            fsqrt,
             exp,
             sqrt,
-            rint,
             div
         );
     }

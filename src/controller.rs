@@ -24,11 +24,11 @@
 //! accumulates time in floating point.
 
 use crate::envelope::Saturation;
-use crate::equilibrium::{Anomaly, ExistenceMonitor};
+use crate::equilibrium::ExistenceMonitor;
 use crate::law::{self, LawFault, LawInput};
-use crate::monitor::Monitor;
+use crate::monitor::{Monitor, SPOOL_MARGIN};
 use crate::real::Real;
-use crate::schedule::{Reference, SlewedSchedule};
+use crate::schedule::{PreparedBand, Reference};
 
 pub use crate::config::{Config, ConfigError, Rule, Stage1Config, Stage2Config};
 pub use crate::envelope::Envelope;
@@ -234,10 +234,52 @@ pub struct Controller<T> {
     anchored: bool,
     monitor: Monitor<T>,
     existence: ExistenceMonitor<T>,
+    derived: Derived<T>,
     /// Events not yet read, oldest first; when full the oldest is dropped and counted.
     events: heapless::Deque<Event, EVENT_CAPACITY>,
     events_dropped: u32,
     last_fault: Option<Fault>,
+}
+
+/// What a step needs of the configuration beyond its plain numbers, worked out once in
+/// [`Controller::new`] (in f64 where it is arithmetic, rounded once to `T`), so that no step
+/// repeats arithmetic that depends on parameters only.
+#[derive(Clone, Copy, Debug)]
+struct Derived<T> {
+    /// The longest plausible length: the spool end plus [`SPOOL_MARGIN`], m.
+    spool_m: T,
+    /// The Eq. 34 schedule, its quintic's coefficients computed.
+    stage1: PreparedBand<T>,
+    /// The Eq. 35 schedule, its quintic's coefficients computed.
+    stage2: PreparedBand<T>,
+    /// −c·Δt of the stage-1 and stage-2 blends: E = e^{−cΔt·k} k ticks after a (re)start.
+    neg_decay_per_tick: [T; 2],
+    /// c of the stage-1 and stage-2 blends, 1/s (Eq. 29; the Eq. 30 acceleration needs it).
+    decay_rate_per_s: [T; 2],
+}
+
+impl<T: Real> Derived<T> {
+    fn new(cfg: &Config<T>) -> Self {
+        let dt = cfg.period_s.to_f64();
+        let neg_decay = |c: T| T::from_f64(-c.to_f64() * dt);
+        Self {
+            spool_m: T::from_f64(cfg.envelope.max_length_m.to_f64() * (1.0 + SPOOL_MARGIN)),
+            stage1: cfg.stage1.schedule.prepare(),
+            stage2: cfg.stage2.schedule.prepare(),
+            neg_decay_per_tick: [
+                neg_decay(cfg.stage1.decay_rate_per_s),
+                neg_decay(cfg.stage2.decay_rate_per_s),
+            ],
+            decay_rate_per_s: [cfg.stage1.decay_rate_per_s, cfg.stage2.decay_rate_per_s],
+        }
+    }
+}
+
+/// Health and phase when a step began (its events are the differences).
+#[derive(Clone, Copy)]
+struct Before {
+    health: Health,
+    phase: Phase,
 }
 
 /// The law's contribution to an output.
@@ -265,6 +307,7 @@ impl<T: Real> Controller<T> {
         })?;
         Ok(Self {
             existence,
+            derived: Derived::new(&cfg),
             stage2: false,
             stage2_requested: false,
             stage_start_tick: 0,
@@ -314,6 +357,7 @@ impl<T: Real> Controller<T> {
         self.events_dropped
     }
 
+    #[inline(never)]
     fn record(&mut self, tick: u32, kind: EventKind) {
         if self.events.is_full() {
             self.events.pop_front();
@@ -340,51 +384,57 @@ impl<T: Real> Controller<T> {
     }
 
     fn advance(&mut self, tick: u32, sample: Option<&Input<T>>) -> Output<T> {
-        let (health, phase) = (self.health, self.phase);
-        let out = self.advance_inner(tick, sample);
-        if out.health != health {
+        let before = Before {
+            health: self.health,
+            phase: self.phase,
+        };
+        self.advance_inner(tick, sample, before)
+    }
+
+    /// Records a step's events just before its output is made, in this order: health change,
+    /// phase change, new fault, blend restart. A quiet step (the common case) records nothing.
+    #[inline(always)]
+    fn note_events(&mut self, tick: u32, before: Before, fault: Option<Fault>, flags: Flags) {
+        if self.health != before.health {
             self.record(
                 tick,
                 EventKind::Health {
-                    from: health,
-                    to: out.health,
+                    from: before.health,
+                    to: self.health,
                 },
             );
         }
-        if out.phase != phase {
-            self.record(tick, EventKind::Phase(out.phase));
+        if self.phase != before.phase {
+            self.record(tick, EventKind::Phase(self.phase));
         }
-        if out.fault.is_some() && out.fault != self.last_fault {
-            if let Some(f) = out.fault {
+        if let Some(f) = fault {
+            if fault != self.last_fault {
                 self.record(tick, EventKind::Fault(f));
             }
         }
-        self.last_fault = out.fault;
-        if out.flags.contains(Flags::BLEND_RESTART) {
+        self.last_fault = fault;
+        if flags.contains(Flags::BLEND_RESTART) {
             self.record(tick, EventKind::BlendRestart);
         }
-        out
     }
 
-    fn advance_inner(&mut self, tick: u32, sample: Option<&Input<T>>) -> Output<T> {
+    fn advance_inner(&mut self, tick: u32, sample: Option<&Input<T>>, before: Before) -> Output<T> {
         let mut flags = Flags::default();
         let dt = self.cfg.period_s;
         // A tick that goes backwards is a bad sample; time does not move.
         let elapsed_ticks = match self.last_tick {
             None => 0,
             Some(last) if tick >= last => tick - last,
-            Some(_) => return self.reject(tick, Fault::Sensor(Sensor::Tick), None, flags),
+            Some(_) => return self.reject(tick, Fault::Sensor(Sensor::Tick), None, flags, before),
         };
         let first = self.last_tick.is_none();
         self.last_tick = Some(tick);
-        let elapsed_s = T::from_u32(elapsed_ticks.max(1)) * dt;
+        let elapsed_s = T::from_u32(elapsed_ticks) * dt;
         // Dead reckoning: the reel ran at the last command since the last step (within the
         // physical range: the reel cannot pay out past its spool nor wind in past zero).
-        let spool =
-            self.cfg.envelope.max_length_m * T::from_f64(1.0 + crate::monitor::SPOOL_MARGIN);
-        self.length_estimate_m = (self.length_estimate_m
-            + self.last_rate_cmd_mps * T::from_u32(elapsed_ticks) * dt)
-            .clamp_to(T::ZERO, spool);
+        // (Both terms are finite: the estimate is clamped, the command is inside the envelope.)
+        self.length_estimate_m = (self.length_estimate_m + self.last_rate_cmd_mps * elapsed_s)
+            .clamp_finite(T::ZERO, self.derived.spool_m);
 
         // Sequencer: stage 1 starts with the first step; stage 2 at its tick or on command.
         // Each stage restarts the blend from the current rate (SPEC §7).
@@ -401,7 +451,7 @@ impl<T: Real> Controller<T> {
         }
 
         let Some(x) = sample else {
-            return self.reject(tick, Fault::Sensor(Sensor::Missing), None, flags);
+            return self.reject(tick, Fault::Sensor(Sensor::Missing), None, flags, before);
         };
         // Before the first accepted sample, and in safe hold, there is no trusted prediction:
         // the next valid sample (re-)anchors it.
@@ -410,47 +460,53 @@ impl<T: Real> Controller<T> {
         } else {
             None
         };
-        let env = self.cfg.envelope;
         if let Err(s) = self
             .monitor
-            .check(&self.cfg.monitor, x, expected, env.max_length_m, dt)
+            .check(&self.cfg.monitor, x, expected, self.derived.spool_m, dt)
         {
-            return self.reject(tick, Fault::Sensor(s), None, flags);
+            return self.reject(tick, Fault::Sensor(s), None, flags, before);
         }
         self.length_estimate_m = x.length_m;
         self.anchored = true;
 
-        let tau_s = T::from_u32(tick.saturating_sub(self.stage_start_tick)) * dt;
-        let reference = self.reference(tau_s, x.length_m);
+        let reference = self.reference(tick, x.length_m);
         if self.health == Health::SafeHold {
             self.good_ticks = self.good_ticks.saturating_add(1);
             if self.good_ticks < self.cfg.monitor.recovery_ticks {
-                return self.hold(tick, &reference, flags, None);
+                return self.hold(tick, &reference, flags, None, before);
             }
             // Recovered: re-engage the law through the Eq. 29 blend from the current rate.
             self.restart_blend(tick, self.last_rate_cmd_mps, &mut flags);
         }
-        let law = match self.solve(x, &reference) {
+        let (mu3, mu3_per_m) = self.cfg.masses.mu3_and_slope(x.length_m);
+        let blend_weight = self.blend_weight(tick);
+        let law = match self.solve(x, &reference, mu3, mu3_per_m, blend_weight) {
             Ok(v) => v,
-            Err(f) => return self.reject(tick, Fault::Law(f), Some(&reference), flags),
+            Err(f) => return self.reject(tick, Fault::Law(f), Some(&reference), flags, before),
         };
         self.set_health(Health::Nominal, &mut flags);
         self.bad_ticks = 0;
 
-        let (rate, sat) = env.limit(law.rate_mps, self.last_rate_cmd_mps, x.length_m, elapsed_s);
+        // The first step has no previous period: the envelope judges it over one period.
+        let limit_s = if elapsed_ticks == 0 { dt } else { elapsed_s };
+        let (rate, sat) =
+            self.cfg
+                .envelope
+                .limit(law.rate_mps, self.last_rate_cmd_mps, x.length_m, limit_s);
         let limited = sat != Saturation::default();
         flags.set_if(sat.rate, Flags::RATE_SATURATED);
         flags.set_if(sat.accel, Flags::ACCEL_SATURATED);
         flags.set_if(sat.length, Flags::LENGTH_LIMITED);
         flags.set_if(law.reference.slewing, Flags::SLEWING);
         let accel = if limited {
-            (rate - self.last_rate_cmd_mps) / elapsed_s
+            (rate - self.last_rate_cmd_mps) / limit_s
         } else {
             law.accel_mps2
         };
         self.last_rate_cmd_mps = rate;
         self.update_phase(x.length_m, law.reference.slewing);
-        let margin = self.equilibrium_margin(x.length_m, rate, &mut flags);
+        let margin = self.equilibrium_margin(mu3, x.length_m, rate, &mut flags);
+        self.note_events(tick, before, None, flags);
         Output {
             tick,
             phase: self.phase,
@@ -458,7 +514,7 @@ impl<T: Real> Controller<T> {
             rate_cmd_mps: rate,
             accel_cmd_mps2: accel,
             law_rate_mps: law.law_rate_mps,
-            blend_weight: self.blend_weight(tick),
+            blend_weight,
             alpha_ref_rad: law.reference.angle.angle_rad,
             alpha_ref_rate_radps: law.ref_rate_radps,
             delta_rad: law.delta_rad,
@@ -470,36 +526,37 @@ impl<T: Real> Controller<T> {
         }
     }
 
+    #[inline(always)]
     fn restart_blend(&mut self, tick: u32, rate_mps: T, flags: &mut Flags) {
         self.blend_start_tick = tick;
         self.blend_initial_rate_mps = rate_mps;
         flags.set(Flags::BLEND_RESTART);
     }
 
+    /// c of the current stage's blend (Eq. 29), 1/s.
+    #[inline(always)]
     fn decay_rate_per_s(&self) -> T {
-        if self.stage2 {
-            self.cfg.stage2.decay_rate_per_s
-        } else {
-            self.cfg.stage1.decay_rate_per_s
-        }
+        self.derived.decay_rate_per_s[usize::from(self.stage2)]
     }
 
-    /// E = e^{−cτ}, τ = time since the blend (re)started (Eq. 29).
+    /// E = e^{−cτ}, τ = k·Δt the time since the blend (re)started k ticks ago (Eq. 29).
+    #[inline(always)]
     fn blend_weight(&self, tick: u32) -> T {
-        let tau_s = T::from_u32(tick.saturating_sub(self.blend_start_tick)) * self.cfg.period_s;
-        (-self.decay_rate_per_s() * tau_s).exp()
+        let k = T::from_u32(tick.saturating_sub(self.blend_start_tick));
+        (self.derived.neg_decay_per_tick[usize::from(self.stage2)] * k).exp()
     }
 
-    fn reference(&self, tau_s: T, length_m: T) -> Reference<T> {
+    /// α_r and its derivatives at this tick and length (Eq. 34, or Eq. 35 with the slew).
+    #[inline(always)]
+    fn reference(&self, tick: u32, length_m: T) -> Reference<T> {
         if self.stage2 {
-            SlewedSchedule {
-                schedule: self.cfg.stage2.schedule,
-                slew_rate_radps: self.cfg.stage2.slew_rate_radps,
-            }
-            .eval(tau_s, length_m)
+            let tau_s = T::from_u32(tick.saturating_sub(self.stage_start_tick)) * self.cfg.period_s;
+            self.derived
+                .stage2
+                .eval_slewed(self.cfg.stage2.slew_rate_radps, tau_s, length_m)
         } else {
             Reference {
-                angle: self.cfg.stage1.schedule.eval(length_m),
+                angle: self.derived.stage1.eval(length_m),
                 time_rate_radps: T::ZERO,
                 slewing: false,
             }
@@ -507,11 +564,16 @@ impl<T: Real> Controller<T> {
     }
 
     /// Eqs. 27 + 29 solved implicitly, and the Eq. 30 acceleration (SPEC §5).
-    fn solve(&self, x: &Input<T>, reference: &Reference<T>) -> Result<LawPart<T>, LawFault> {
-        let l = x.length_m;
-        let (mu3, mu3_per_m) = self.cfg.masses.mu3_and_slope(l);
+    fn solve(
+        &self,
+        x: &Input<T>,
+        reference: &Reference<T>,
+        mu3: T,
+        mu3_per_m: T,
+        blend_weight: T,
+    ) -> Result<LawPart<T>, LawFault> {
         let law_in = LawInput {
-            length_m: l,
+            length_m: x.length_m,
             alpha_rad: x.alpha_rad,
             alpha_rate_radps: x.alpha_rate_radps,
             orbit_rate_radps: x.orbit_rate_radps,
@@ -521,7 +583,7 @@ impl<T: Real> Controller<T> {
             ref_time_rate_radps: reference.time_rate_radps,
             mu3,
             mu3_per_m,
-            blend_weight: self.blend_weight(x.tick),
+            blend_weight,
             decay_rate_per_s: self.decay_rate_per_s(),
             initial_rate_mps: self.blend_initial_rate_mps,
             gains: self.cfg.gains,
@@ -539,6 +601,7 @@ impl<T: Real> Controller<T> {
         })
     }
 
+    #[inline(always)]
     fn set_health(&mut self, h: Health, flags: &mut Flags) {
         if self.health != h {
             self.health = h;
@@ -557,6 +620,7 @@ impl<T: Real> Controller<T> {
         fault: Fault,
         reference: Option<&Reference<T>>,
         mut flags: Flags,
+        before: Before,
     ) -> Output<T> {
         self.bad_ticks = self.bad_ticks.saturating_add(1);
         let next =
@@ -568,9 +632,11 @@ impl<T: Real> Controller<T> {
         self.set_health(next, &mut flags);
         self.good_ticks = 0;
         // Without a usable sample, α_r is reported at the predicted length.
-        let tau_s = T::from_u32(tick.saturating_sub(self.stage_start_tick)) * self.cfg.period_s;
-        let predicted = self.reference(tau_s, self.length_estimate_m);
-        self.hold(tick, reference.unwrap_or(&predicted), flags, Some(fault))
+        let reference = match reference {
+            Some(r) => *r,
+            None => self.reference(tick, self.length_estimate_m),
+        };
+        self.hold(tick, &reference, flags, Some(fault), before)
     }
 
     /// The safe actions. Degraded: keep the last command (coast). Safe hold: ramp the rate to
@@ -582,6 +648,7 @@ impl<T: Real> Controller<T> {
         reference: &Reference<T>,
         mut flags: Flags,
         fault: Option<Fault>,
+        before: Before,
     ) -> Output<T> {
         flags.set(Flags::SAFE_ACTION);
         let dt = self.cfg.period_s;
@@ -597,7 +664,9 @@ impl<T: Real> Controller<T> {
             .limit(target, prev, self.length_estimate_m, dt);
         flags.set_if(sat.length, Flags::LENGTH_LIMITED);
         self.last_rate_cmd_mps = rate;
-        let margin = self.equilibrium_margin(self.length_estimate_m, rate, &mut flags);
+        let mu3 = self.cfg.masses.mu3_and_slope(self.length_estimate_m).0;
+        let margin = self.equilibrium_margin(mu3, self.length_estimate_m, rate, &mut flags);
+        self.note_events(tick, before, fault, flags);
         Output {
             tick,
             phase: self.phase,
@@ -618,27 +687,25 @@ impl<T: Real> Controller<T> {
     }
 
     /// The Eq. 13 margin of the command (whole orbit), flagging a command outside the region.
-    fn equilibrium_margin(&self, length_m: T, rate_mps: T, flags: &mut Flags) -> T {
-        let mu3 = self.cfg.masses.mu3_and_slope(length_m).0;
-        match self
-            .existence
-            .check_rate(Anomaly::WholeOrbit, mu3, length_m, rate_mps)
-        {
-            Ok(c) => {
-                flags.set_if(!c.exists, Flags::NO_EQUILIBRIUM);
+    #[inline(always)]
+    fn equilibrium_margin(&self, mu3: T, length_m: T, rate_mps: T, flags: &mut Flags) -> T {
+        match self.existence.whole_orbit_margin(mu3, length_m, rate_mps) {
+            Some(margin) => {
+                flags.set_if(margin < T::ZERO, Flags::NO_EQUILIBRIUM);
                 // x grows as 1/l: near docking the margin can exceed f32; report it bounded.
                 let bound = T::from_f64(MAX_REPORTED_MARGIN);
-                c.margin.clamp_to(-bound, bound)
+                margin.clamp_finite(-bound, bound)
             }
-            // Only a non-positive or non-finite length estimate gets here (a long coast
-            // toward docking): no equilibrium statement can be made.
-            Err(_) => {
+            // Only a non-positive length estimate gets here (a long coast toward docking): no
+            // equilibrium statement can be made.
+            None => {
                 flags.set(Flags::NO_EQUILIBRIUM);
                 T::ZERO
             }
         }
     }
 
+    #[inline(always)]
     fn update_phase(&mut self, length_m: T, slewing: bool) {
         let capture = self.cfg.keep_capture_m;
         self.phase = match self.phase {

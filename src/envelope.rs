@@ -54,6 +54,7 @@ impl<T: Real> Envelope<T> {
     ///
     /// The result is finite and within ±`max_rate_mps` whenever `previous_mps` is (a NaN
     /// request is treated as a request to keep the previous command).
+    #[inline(always)]
     pub fn limit(
         &self,
         requested_mps: T,
@@ -77,33 +78,31 @@ impl<T: Real> Envelope<T> {
             sat.accel = true;
             y = y.clamp_to(previous_mps - dv, previous_mps + dv);
         }
+        // Only the length limit ahead of the motion can bind: the spool end when paying out,
+        // docking when winding in. Far from it (the braking distance at y, plus two periods,
+        // fits in the room left) the command passes as it is.
         let guard = T::from_f64(LENGTH_GUARD_REL);
-        let up_room = (self.max_length_m * (T::ONE - guard) - length_m).max(T::ZERO);
-        let down_room = (length_m - self.min_length_m * (T::ONE + guard)).max(T::ZERO);
-        // The staircase (two square roots) only matters near a limit: a speed v toward it is
-        // always allowed while the room exceeds v²/(2a) + 2vΔt, a bound on the distance the
-        // staircase needs to stop from v (it needs at most v²/(2a) + vΔt).
         let two = T::from_f64(2.0);
         let far = |v: T, room: T| v * (v / (two * self.max_accel_mps2) + two * dt_s) <= room;
-        let clear_up = y <= T::ZERO || far(y, up_room);
-        let clear_down = y >= T::ZERO || far(-y, down_room);
-        let up = if clear_up {
-            vmax
+        let (up, down) = if y > T::ZERO {
+            let up_room = (self.max_length_m * (T::ONE - guard) - length_m).max(T::ZERO);
+            if far(y, up_room) {
+                return (Self::settle(y, vmax, sat), sat);
+            }
+            (self.braking_speed(up_room, dt_s), -vmax)
+        } else if y < T::ZERO {
+            let down_room = (length_m - self.min_length_m * (T::ONE + guard)).max(T::ZERO);
+            if far(-y, down_room) {
+                return (Self::settle(y, vmax, sat), sat);
+            }
+            (vmax, -self.braking_speed(down_room, dt_s))
         } else {
-            self.braking_speed(up_room, dt_s)
-        };
-        let down = if clear_down {
-            -vmax
-        } else {
-            -self.braking_speed(down_room, dt_s)
+            // Zero (or NaN, when `previous_mps` is: the documented fallback is −vmax).
+            return (y.clamp_to(-vmax, vmax), sat);
         };
         if y > up || y < down {
             sat.length = true;
             y = y.clamp_to(down, up);
-            // The braking curve keeps the acceleration limit in exact arithmetic; the f32
-            // rounding of the sensed length (≈ 1 mm at 30 km) can make it ask for a hair more.
-            // Travel within the guard is allowed for that, so the acceleration limit holds and
-            // the limit itself (beyond the guard) is still never passed.
             let guard_m = self.max_length_m * guard;
             let (lo, hi) = (previous_mps - dv, previous_mps + dv);
             if y < lo && (lo - y) * dt_s <= guard_m {
@@ -112,11 +111,23 @@ impl<T: Real> Envelope<T> {
                 y = hi;
             }
         }
-        (y.clamp_to(-vmax, vmax), sat)
+        (y.clamp_finite(-vmax, vmax), sat)
+    }
+
+    /// The command when no length limit acts: `y` is already within ±`vmax` unless the
+    /// acceleration clamp moved it (toward a `previous_mps` that could lie outside).
+    #[inline(always)]
+    fn settle(y: T, vmax: T, sat: Saturation) -> T {
+        if sat.accel {
+            y.clamp_finite(-vmax, vmax)
+        } else {
+            y
+        }
     }
 
     /// The largest speed toward a limit `room_m` away from which the reel can still stop at
     /// it, decelerating by at most a·Δt per period (see the module docs).
+    #[inline(never)]
     fn braking_speed(&self, room_m: T, dt_s: T) -> T {
         let half = T::from_f64(0.5);
         let dv = self.max_accel_mps2 * dt_s;

@@ -477,6 +477,28 @@ impl<T: Real> ExistenceMonitor<T> {
         })
     }
 
+    /// The signed whole-orbit (Eq. 13) margin of [`check_rate`](Self::check_rate) alone, for
+    /// the controller's every step: min(min Depl − x, x − max Retr) with x = (2 + μ3) l̇/(ω l),
+    /// ≥ 0 exactly when an equilibrium exists over the whole orbit. `None` when l ≤ 0 or x is
+    /// not finite (where `check_rate` returns an error).
+    #[inline]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(l > 0)` is meant: it is true for NaN.
+    pub fn whole_orbit_margin(&self, mu3: T, length_m: T, length_rate_mps: T) -> Option<T> {
+        if !(length_m > T::ZERO) {
+            return None;
+        }
+        let x = normalised_rate(mu3, length_rate_mps / length_m, self.mean_motion_radps);
+        if !x.is_finite() {
+            return None;
+        }
+        let (above, below) = (
+            self.extent.min_depl.value - x,
+            x - self.extent.max_retr.value,
+        );
+        // Both finite: a plain comparison is the minimum.
+        Some(if below < above { below } else { above })
+    }
+
     /// [`check`](Self::check) from the reel's length l (m, > 0) and rate l̇ (m/s).
     pub fn check_rate(
         &self,
@@ -605,6 +627,35 @@ mod tests {
                 (a.anomaly_rad as f64 - b.anomaly_rad).abs() < 1e-3,
                 "e = {e}"
             );
+        }
+    }
+
+    #[test]
+    fn whole_orbit_margin_is_check_rates_margin() {
+        let m = ExistenceMonitor::new(0.3_f64, 1.06e-3).unwrap();
+        for &(mu3, l, rate) in &[
+            (0.0, 1.0, 0.1),
+            (0.0, 30_000.0, 0.0),
+            (0.05, 12_000.0, 3.0),
+            (0.0, 2_000.0, -1.5),
+            (0.02, 5.0, -12.0),
+            (0.0, 1e-3, 15.0),
+        ] {
+            let c = m
+                .check_rate(Anomaly::WholeOrbit, mu3, l, rate)
+                .expect("valid input");
+            let margin = m.whole_orbit_margin(mu3, l, rate).expect("valid input");
+            assert_eq!(margin, c.margin, "l = {l}, rate = {rate}");
+            assert_eq!(margin >= 0.0, c.exists, "l = {l}, rate = {rate}");
+        }
+        for &(l, rate) in &[
+            (0.0, 1.0),
+            (-1.0, 1.0),
+            (f64::NAN, 1.0),
+            (1.0, f64::INFINITY),
+        ] {
+            assert!(m.whole_orbit_margin(0.0, l, rate).is_none());
+            assert!(m.check_rate(Anomaly::WholeOrbit, 0.0, l, rate).is_err());
         }
     }
 }

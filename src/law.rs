@@ -138,7 +138,9 @@ pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
         k1 * (x.alpha_rate_radps - x.ref_time_rate_radps) + x.gains.k2_per_s2 * delta - gravity;
     let b = w + p * (e * x.initial_rate_mps + (T::ONE - e) * l_prime * k1);
     let c = e * x.initial_rate_mps * w + (T::ONE - e) * l_prime * g0;
-    if !(b.is_finite() && c.is_finite()) {
+    // One test for both: the sum of two finite values of this size is finite, and a NaN or an
+    // infinity in either makes it NaN or infinite.
+    if !(b + c).is_finite() {
         return Err(LawFault::NotFinite);
     }
     if b <= T::from_f64(MIN_DENOMINATOR_FRACTION) * n.abs() {
@@ -157,7 +159,7 @@ pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
     }
     // Eq. 27 itself, evaluated with the consistent δ̇.
     let law_rate = (k1 * delta_rate + x.gains.k2_per_s2 * delta - gravity) / denom * l_prime;
-    if !(y.is_finite() && law_rate.is_finite()) {
+    if !(y + law_rate).is_finite() {
         return Err(LawFault::NotFinite);
     }
     Ok(LawOutput {

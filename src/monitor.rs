@@ -132,30 +132,33 @@ impl<T: Real> Monitor<T> {
     }
 
     /// Checks one sample. `expected_length_m` is the length the controller predicts for this
-    /// tick (`None` when it has no trustworthy prediction); `max_length_m` is the spool end.
+    /// tick (`None` when it has no trustworthy prediction); `spool_m` is the longest plausible
+    /// length (the spool end plus [`SPOOL_MARGIN`]).
+    ///
+    /// Each range check is one comparison chain that NaN fails (every comparison with NaN is
+    /// false) and that ±∞ fails (the bounds are finite), so "finite and in range" costs no
+    /// separate finiteness test.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(range)` is meant: it is true for NaN.
     pub(crate) fn check(
         &mut self,
         cfg: &MonitorConfig<T>,
         x: &Input<T>,
         expected_length_m: Option<T>,
-        max_length_m: T,
+        spool_m: T,
         period_s: T,
     ) -> Result<(), Sensor> {
         let pi = T::from_f64(core::f64::consts::PI);
-        let spool = max_length_m * T::from_f64(1.0 + SPOOL_MARGIN);
         let shortest = T::from_f64(MIN_PLAUSIBLE_LENGTH_M);
-        if !(x.length_m.is_finite() && x.length_m >= shortest && x.length_m <= spool) {
+        if !(x.length_m >= shortest && x.length_m <= spool_m) {
             return Err(Sensor::Length);
         }
-        if !(x.alpha_rad.is_finite() && x.alpha_rad.abs() <= pi) {
+        if !(x.alpha_rad.abs() <= pi) {
             return Err(Sensor::Alpha);
         }
-        if !(x.alpha_rate_radps.is_finite() && x.alpha_rate_radps.abs() <= cfg.max_alpha_rate_radps)
-        {
+        if !(x.alpha_rate_radps.abs() <= cfg.max_alpha_rate_radps) {
             return Err(Sensor::AlphaRate);
         }
-        if !(x.orbit_rate_radps.is_finite()
-            && x.orbit_rate_radps >= cfg.min_orbit_rate_radps
+        if !(x.orbit_rate_radps >= cfg.min_orbit_rate_radps
             && x.orbit_rate_radps <= cfg.max_orbit_rate_radps)
         {
             return Err(Sensor::OrbitRate);
@@ -166,25 +169,27 @@ impl<T: Real> Monitor<T> {
             }
         }
         if let Some(last) = self.last {
-            let ticks = x.tick.saturating_sub(last.tick).max(1);
-            let dt = T::from_u32(ticks) * period_s;
-            let predicted = last.alpha_rad + last.alpha_rate_radps * dt;
-            if (x.alpha_rad - predicted).abs() > cfg.alpha_jump_rad * T::from_u32(ticks) {
+            let ticks = T::from_u32(x.tick.saturating_sub(last.tick).max(1));
+            let predicted = last.alpha_rad + last.alpha_rate_radps * (ticks * period_s);
+            if (x.alpha_rad - predicted).abs() > cfg.alpha_jump_rad * ticks {
                 return Err(Sensor::AlphaJump);
             }
         }
         // Stuck: the same reading again and again while α̇ says it should have moved.
-        let bits = x.alpha_rad.to_f64().to_bits();
+        let bits = x.alpha_rad.bits();
         if self.same_count > 0 && bits == self.same_alpha_bits {
             self.same_count = self.same_count.saturating_add(1);
             self.implied_motion_rad = self.implied_motion_rad + x.alpha_rate_radps.abs() * period_s;
+            if self.same_count >= cfg.stuck_ticks && self.implied_motion_rad >= cfg.stuck_motion_rad
+            {
+                return Err(Sensor::AlphaStuck);
+            }
         } else {
+            // A fresh reading (the usual case) cannot be stuck: no implied motion yet, and
+            // `stuck_motion_rad` > 0.
             self.same_alpha_bits = bits;
             self.same_count = 1;
             self.implied_motion_rad = T::ZERO;
-        }
-        if self.same_count >= cfg.stuck_ticks && self.implied_motion_rad >= cfg.stuck_motion_rad {
-            return Err(Sensor::AlphaStuck);
         }
         self.last = Some(Accepted {
             tick: x.tick,

@@ -55,6 +55,8 @@ pub trait Real:
     fn asin(self) -> Self;
     /// `true` unless NaN or infinite.
     fn is_finite(self) -> bool;
+    /// The IEEE bit pattern, widened to 64 bits (equal patterns ⇔ identical values).
+    fn bits(self) -> u64;
 
     /// The smaller of two values (the non-NaN one if one is NaN).
     #[inline]
@@ -81,6 +83,18 @@ pub trait Real:
             lo
         } else {
             self.max(lo).min(hi)
+        }
+    }
+    /// `self` limited to `[lo, hi]` for a `self` known not to be NaN (two plain comparisons;
+    /// a NaN `self` comes back as NaN). The hot path's choice where NaN cannot occur.
+    #[inline]
+    fn clamp_finite(self, lo: Self, hi: Self) -> Self {
+        if self < lo {
+            lo
+        } else if self > hi {
+            hi
+        } else {
+            self
         }
     }
     /// `true` for NaN.
@@ -125,7 +139,7 @@ impl Real for f32 {
     }
     #[inline]
     fn exp(self) -> Self {
-        libm::expf(self)
+        crate::fastmath::exp(self)
     }
     #[inline]
     fn sqrt(self) -> Self {
@@ -150,6 +164,10 @@ impl Real for f32 {
     #[inline]
     fn is_finite(self) -> bool {
         f32::is_finite(self)
+    }
+    #[inline]
+    fn bits(self) -> u64 {
+        u64::from(self.to_bits())
     }
 }
 
@@ -203,6 +221,10 @@ impl Real for f64 {
     #[inline]
     fn is_finite(self) -> bool {
         f64::is_finite(self)
+    }
+    #[inline]
+    fn bits(self) -> u64 {
+        self.to_bits()
     }
 }
 

@@ -75,67 +75,158 @@ impl<T: Real> BandSchedule<T> {
     /// α_r(l), ∂α_r/∂l and ∂²α_r/∂l² at tether length `length_m` (Eqs. 34/35).
     ///
     /// Total for every input: a NaN length yields NaN outputs, which the controller's input
-    /// validation rejects before calling this.
+    /// validation rejects before calling this. Builds the [`PreparedBand`] each call; a caller
+    /// that evaluates the schedule every period (the controller) prepares it once.
     pub fn eval(&self, length_m: T) -> RefAngle<T> {
-        if length_m <= self.low_length_m {
-            return RefAngle {
-                angle_rad: self.low_angle_rad
-                    + self.low_slope_rad_per_m * (length_m - self.low_length_m),
-                slope_rad_per_m: self.low_slope_rad_per_m,
-                curvature_rad_per_m2: T::ZERO,
-            };
-        }
-        if length_m >= self.high_length_m {
-            return RefAngle {
-                angle_rad: self.high_angle_rad
-                    + self.high_slope_rad_per_m * (length_m - self.high_length_m),
-                slope_rad_per_m: self.high_slope_rad_per_m,
-                curvature_rad_per_m2: T::ZERO,
-            };
-        }
-        // Transition band: the quintic with f″ = 0 at both ends (SPEC §6), written around the
-        // nearer end of the band: f = f_e + h f'_e u + u³(c3 + u(c4 + u c5)) with u the
-        // distance from that end in band widths, so that near an end (station keeping sits at
-        // them) f32 keeps the precision of the straight piece instead of losing ~1e-6 rad to
-        // cancellation among the Hermite basis functions.
-        let h = self.high_length_m - self.low_length_m;
-        let half = T::from_f64(0.5);
-        let from_low = (length_m - self.low_length_m) / h;
-        let (u, sign, f_end, k_end, f_far, k_far) = if from_low <= half {
-            (
-                from_low,
-                T::ONE,
-                self.low_angle_rad,
-                self.low_slope_rad_per_m,
-                self.high_angle_rad,
-                self.high_slope_rad_per_m,
-            )
-        } else {
-            (
-                (self.high_length_m - length_m) / h,
-                -T::ONE,
-                self.high_angle_rad,
-                self.high_slope_rad_per_m,
-                self.low_angle_rad,
-                self.low_slope_rad_per_m,
-            )
+        self.prepare().eval(length_m)
+    }
+
+    /// The schedule with its quintic's coefficients worked out (in f64, rounded once to `T`).
+    pub fn prepare(&self) -> PreparedBand<T> {
+        let f = |x: T| x.to_f64();
+        let (lo, hi) = (f(self.low_length_m), f(self.high_length_m));
+        let h = hi - lo;
+        let end = |length: T, angle: T, slope: T, far_angle: T, far_slope: T, dir: f64| {
+            // The quintic written around this end (SPEC §6): in u = distance from this end in
+            // band widths (du/dl = dir/h), g(0) = f_e, g'(0) = dir·h·k_e, g'(1) = dir·h·k_far,
+            // g''(0) = g''(1) = 0:  g = f_e + g1 u + u³(c3 + u(c4 + u c5)).
+            let g1 = dir * h * f(slope);
+            let delta = f(far_angle) - f(angle) - g1;
+            let d = dir * h * (f(far_slope) - f(slope));
+            let c3 = 10.0 * delta - 4.0 * d;
+            let c4 = -15.0 * delta + 7.0 * d;
+            let c5 = 6.0 * delta - 3.0 * d;
+            let t = T::from_f64;
+            BandEnd {
+                length_m: length,
+                u_per_m: t(dir / h),
+                angle_rad: angle,
+                slope_rad_per_m: slope,
+                g1_rad: t(g1),
+                c3_rad: t(c3),
+                c4_rad: t(c4),
+                c5_rad: t(c5),
+                // ∂α_r/∂l = (dir/h) g'(u) = k_e + u²(s3 + u(s4 + u s5)).
+                s3_rad_per_m: t(dir * 3.0 * c3 / h),
+                s4_rad_per_m: t(dir * 4.0 * c4 / h),
+                s5_rad_per_m: t(dir * 5.0 * c5 / h),
+                // ∂²α_r/∂l² = g''(u)/h² = u(q6 + u(q12 + u q20)).
+                q6_rad_per_m2: t(6.0 * c3 / (h * h)),
+                q12_rad_per_m2: t(12.0 * c4 / (h * h)),
+                q20_rad_per_m2: t(20.0 * c5 / (h * h)),
+            }
         };
-        // In the variable u (du/dl = sign/h): g(0) = f_e, g'(0) = sign·h·k_e, g'(1) = sign·h·k_far.
-        let g1 = sign * h * k_end;
-        let delta = f_far - f_end - g1;
-        let d = sign * h * (k_far - k_end);
-        let c = |x: f64| T::from_f64(x);
-        let c3 = c(10.0) * delta - c(4.0) * d;
-        let c4 = c(-15.0) * delta + c(7.0) * d;
-        let c5 = c(6.0) * delta - c(3.0) * d;
+        PreparedBand {
+            low: end(
+                self.low_length_m,
+                self.low_angle_rad,
+                self.low_slope_rad_per_m,
+                self.high_angle_rad,
+                self.high_slope_rad_per_m,
+                1.0,
+            ),
+            high: end(
+                self.high_length_m,
+                self.high_angle_rad,
+                self.high_slope_rad_per_m,
+                self.low_angle_rad,
+                self.low_slope_rad_per_m,
+                -1.0,
+            ),
+            mid_length_m: T::from_f64(lo + 0.5 * h),
+        }
+    }
+}
+
+/// One end of a [`PreparedBand`]: the straight piece beyond it and the quintic written around it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct BandEnd<T> {
+    length_m: T,
+    /// du/dl: +1/h at the low end, −1/h at the high end, 1/m.
+    u_per_m: T,
+    angle_rad: T,
+    slope_rad_per_m: T,
+    g1_rad: T,
+    c3_rad: T,
+    c4_rad: T,
+    c5_rad: T,
+    s3_rad_per_m: T,
+    s4_rad_per_m: T,
+    s5_rad_per_m: T,
+    q6_rad_per_m2: T,
+    q12_rad_per_m2: T,
+    q20_rad_per_m2: T,
+}
+
+/// A [`BandSchedule`] ready to evaluate every period: the transition quintic of SPEC §6 written
+/// around each end of the band, its coefficients computed once (in f64) by
+/// [`BandSchedule::prepare`].
+///
+/// Inside the band the half nearer to `l` is used, with u the distance from that end in band
+/// widths (0 ≤ u ≤ ½): near an end (station keeping sits at them) f32 keeps the precision of
+/// the straight piece instead of losing ~1e-6 rad to cancellation among the Hermite basis
+/// functions. A step costs one multiplication for u and three short Horner chains.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PreparedBand<T> {
+    low: BandEnd<T>,
+    high: BandEnd<T>,
+    mid_length_m: T,
+}
+
+impl<T: Real> PreparedBand<T> {
+    /// α_r(l), ∂α_r/∂l and ∂²α_r/∂l² (Eqs. 34/35); see [`BandSchedule::eval`].
+    #[inline]
+    pub fn eval(&self, length_m: T) -> RefAngle<T> {
+        let straight = |e: &BandEnd<T>| RefAngle {
+            angle_rad: e.angle_rad + e.slope_rad_per_m * (length_m - e.length_m),
+            slope_rad_per_m: e.slope_rad_per_m,
+            curvature_rad_per_m2: T::ZERO,
+        };
+        if length_m <= self.low.length_m {
+            return straight(&self.low);
+        }
+        if length_m >= self.high.length_m {
+            return straight(&self.high);
+        }
+        let e = if length_m <= self.mid_length_m {
+            &self.low
+        } else {
+            &self.high
+        };
+        let u = (length_m - e.length_m) * e.u_per_m;
         let u2 = u * u;
-        let g = f_end + g1 * u + u2 * u * (c3 + u * (c4 + u * c5));
-        let g_u = g1 + u2 * (c(3.0) * c3 + u * (c(4.0) * c4 + u * c(5.0) * c5));
-        let g_uu = u * (c(6.0) * c3 + u * (c(12.0) * c4 + u * c(20.0) * c5));
         RefAngle {
-            angle_rad: g,
-            slope_rad_per_m: sign * g_u / h,
-            curvature_rad_per_m2: g_uu / (h * h),
+            angle_rad: e.angle_rad
+                + e.g1_rad * u
+                + u2 * u * (e.c3_rad + u * (e.c4_rad + u * e.c5_rad)),
+            slope_rad_per_m: e.slope_rad_per_m
+                + u2 * (e.s3_rad_per_m + u * (e.s4_rad_per_m + u * e.s5_rad_per_m)),
+            curvature_rad_per_m2: u
+                * (e.q6_rad_per_m2 + u * (e.q12_rad_per_m2 + u * e.q20_rad_per_m2)),
+        }
+    }
+
+    /// The stage-2 reference on this schedule (see [`SlewedSchedule`]).
+    #[inline]
+    pub fn eval_slewed(&self, slew_rate_radps: T, tau_s: T, length_m: T) -> Reference<T> {
+        let scheduled = self.eval(length_m);
+        let ramp = slew_rate_radps * tau_s;
+        if ramp < scheduled.angle_rad {
+            Reference {
+                angle: RefAngle {
+                    angle_rad: ramp,
+                    slope_rad_per_m: T::ZERO,
+                    curvature_rad_per_m2: T::ZERO,
+                },
+                time_rate_radps: slew_rate_radps,
+                slewing: true,
+            }
+        } else {
+            Reference {
+                angle: scheduled,
+                time_rate_radps: T::ZERO,
+                slewing: false,
+            }
         }
     }
 }
@@ -168,25 +259,9 @@ pub struct Reference<T> {
 impl<T: Real> SlewedSchedule<T> {
     /// The reference at stage time `tau_s` and tether length `length_m`.
     pub fn eval(&self, tau_s: T, length_m: T) -> Reference<T> {
-        let scheduled = self.schedule.eval(length_m);
-        let ramp = self.slew_rate_radps * tau_s;
-        if ramp < scheduled.angle_rad {
-            Reference {
-                angle: RefAngle {
-                    angle_rad: ramp,
-                    slope_rad_per_m: T::ZERO,
-                    curvature_rad_per_m2: T::ZERO,
-                },
-                time_rate_radps: self.slew_rate_radps,
-                slewing: true,
-            }
-        } else {
-            Reference {
-                angle: scheduled,
-                time_rate_radps: T::ZERO,
-                slewing: false,
-            }
-        }
+        self.schedule
+            .prepare()
+            .eval_slewed(self.slew_rate_radps, tau_s, length_m)
     }
 }
 

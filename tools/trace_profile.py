@@ -31,7 +31,7 @@ CATEGORIES = [
     ("law::acceleration", r"law::acceleration"),
     ("envelope: libm::sqrtf", r"sqrt.*(Envelope|envelope::)"),
     ("envelope: the rest", r"Envelope|envelope::"),
-    ("blend e^(-cτ): libm::expf", r"expf"),
+    ("blend e^(-cτ): fastmath::exp", r"expf|fastmath::exp|blend_weight"),
     ("mass model (coefficients, mu3_rate)", r"MassModel"),
     ("existence check (Eq. 13 margin)", r"equilibrium::|equilibrium_margin"),
     ("sensor validation (Monitor::check)", r"Monitor.*::check"),
@@ -54,6 +54,10 @@ def main():
     ap.add_argument("--elf", default="target/thumbv7em-none-eabihf/firmware/tss-reel")
     ap.add_argument("--tick", type=int, default=301)
     ap.add_argument("--top", type=int, default=25)
+    ap.add_argument("--lines", action="store_true",
+                    help="also count instructions per source line (innermost frame)")
+    ap.add_argument("--within", default="",
+                    help="with --lines: only instructions whose category matches this regex")
     a = ap.parse_args()
 
     with tempfile.TemporaryDirectory() as tmp:
@@ -98,12 +102,13 @@ def main():
         ["llvm-symbolizer", "--inlining", "--functions=linkage", "--demangle", "--obj=" + a.elf],
         input="\n".join(f"0x{p:x}" for p in uniq), capture_output=True, text=True, check=True
     ).stdout
-    chains = {}
+    chains, where = {}, {}
     for pc, block in zip(uniq, out.strip().split("\n\n")):
         lines = block.split("\n")
         chains[pc] = [demangle_short(lines[i]) for i in range(0, len(lines) - 1, 2)]
+        where[pc] = re.sub(r"^.*/(src|examples)/", r"\1/", lines[1]) if len(lines) > 1 else "?"
 
-    by_cat, by_fn = collections.Counter(), collections.Counter()
+    by_cat, by_fn, by_line = collections.Counter(), collections.Counter(), collections.Counter()
     stack, prev_pc = [], None  # [(start, end, caller's chain)]
     for pc in pcs:
         while stack and not stack[-1][0] <= pc < stack[-1][1]:
@@ -117,6 +122,8 @@ def main():
         cat = next((c for c, p in CATEGORIES if re.search(p, chain)), "other: " + full[-1])
         by_cat[cat] += 1
         by_fn[chains[pc][0]] += 1
+        if re.search(a.within, cat):
+            by_line[where[pc] + "  [" + " < ".join(chains[pc][:3]) + "]"] += 1
     total = len(pcs)
     print(f"{a.elf}: tick {a.tick}: {total} instructions, SysTick entry to SysTick entry")
     for cat, n in by_cat.most_common():
@@ -124,6 +131,10 @@ def main():
     print(f"innermost source functions (top {a.top}):")
     for fn, n in by_fn.most_common(a.top):
         print(f"  {n:6d}  {fn}")
+    if a.lines:
+        print(f"source lines (top {a.top}):")
+        for line, n in by_line.most_common(a.top):
+            print(f"  {n:6d}  {line}")
 
 
 if __name__ == "__main__":
