@@ -7,7 +7,10 @@ ticks, and attributes every instruction of tick N to the source function it came
 the inlining chain (llvm-symbolizer --inlining). So the breakdown is that of the flight codegen,
 with everything LLVM inlined into `Controller::step` sorted back into the paper's pieces.
 
-    tools/trace_profile.py [--elf ELF] [--tick N] [--top K]
+    tools/trace_profile.py [--elf ELF] [--tick N] [--top K] [--lines [--within REGEX]]
+
+--lines adds the instructions per source line (innermost frame, with its inlining chain);
+--within REGEX keeps only the lines of the categories matching REGEX (e.g. "Monitor").
 
 Defaults: the flight firmware (target/thumbv7em-none-eabihf/firmware/tss-reel, build it with
 `cargo fw-build`), tick 301 (a nominal deploy step that logs nothing). Needs qemu-system-arm
