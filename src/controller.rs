@@ -208,6 +208,60 @@ pub struct Event {
     pub kind: EventKind,
 }
 
+/// The controller's event queue: a ring of [`EVENT_CAPACITY`] events that drops (and counts)
+/// the oldest when a new one finds it full. A push is a handful of instructions with no
+/// branches beyond the full check, so a step that records events stays close to a quiet one.
+#[derive(Clone, Debug)]
+struct EventRing {
+    buf: [Event; EVENT_CAPACITY],
+    /// Index of the oldest unread event.
+    head: usize,
+    /// Unread events, at most [`EVENT_CAPACITY`].
+    len: usize,
+    /// Events dropped because the ring was full.
+    dropped: u32,
+}
+
+const _: () = assert!(EVENT_CAPACITY.is_power_of_two());
+
+impl EventRing {
+    const fn new() -> Self {
+        Self {
+            buf: [Event {
+                tick: 0,
+                kind: EventKind::BlendRestart,
+            }; EVENT_CAPACITY],
+            head: 0,
+            len: 0,
+            dropped: 0,
+        }
+    }
+
+    /// Appends `e`; when the ring is full the oldest event makes room (and is counted).
+    #[inline(always)]
+    fn push(&mut self, e: Event) {
+        const MASK: usize = EVENT_CAPACITY - 1;
+        if self.len == EVENT_CAPACITY {
+            self.head = (self.head + 1) & MASK;
+            self.dropped = self.dropped.saturating_add(1);
+        } else {
+            self.len += 1;
+        }
+        self.buf[(self.head + self.len - 1) & MASK] = e;
+    }
+
+    /// Takes the oldest unread event.
+    fn pop(&mut self) -> Option<Event> {
+        if self.len == 0 {
+            return None;
+        }
+        let e = self.buf[self.head];
+        self.head = (self.head + 1) & (EVENT_CAPACITY - 1);
+        self.len -= 1;
+        Some(e)
+    }
+}
+
 /// Bound on the reported [`Output::equilibrium_margin`] (x grows as 1/l toward docking).
 pub const MAX_REPORTED_MARGIN: f64 = 1e6;
 
@@ -216,7 +270,9 @@ pub const MAX_REPORTED_MARGIN: f64 = 1e6;
 pub struct Controller<T> {
     cfg: Config<T>,
     stage2: bool,
-    stage2_requested: bool,
+    /// The first tick at which stage 2 begins: the configured start, 0 once stage 2 is
+    /// requested, never (`u64::MAX`) once it has begun. One comparison a step.
+    stage2_due_tick: u64,
     stage_start_tick: u32,
     blend_start_tick: u32,
     blend_initial_rate_mps: T,
@@ -236,8 +292,7 @@ pub struct Controller<T> {
     existence: ExistenceMonitor<T>,
     derived: Derived<T>,
     /// Events not yet read, oldest first; when full the oldest is dropped and counted.
-    events: heapless::Deque<Event, EVENT_CAPACITY>,
-    events_dropped: u32,
+    events: EventRing,
     last_fault: Option<Fault>,
 }
 
@@ -309,7 +364,7 @@ impl<T: Real> Controller<T> {
             existence,
             derived: Derived::new(&cfg),
             stage2: false,
-            stage2_requested: false,
+            stage2_due_tick: cfg.stage2.start_tick.map_or(u64::MAX, u64::from),
             stage_start_tick: 0,
             blend_start_tick: 0,
             blend_initial_rate_mps: cfg.initial_rate_mps,
@@ -321,8 +376,7 @@ impl<T: Real> Controller<T> {
             last_rate_cmd_mps: cfg.initial_rate_mps,
             length_estimate_m: T::ZERO,
             anchored: false,
-            events: heapless::Deque::new(),
-            events_dropped: 0,
+            events: EventRing::new(),
             last_fault: None,
             monitor: Monitor::new(),
             cfg,
@@ -349,27 +403,24 @@ impl<T: Real> Controller<T> {
     /// The queue holds [`EVENT_CAPACITY`] events; read it every period so none are dropped
     /// ([`Controller::events_dropped`] counts any that were).
     pub fn pop_event(&mut self) -> Option<Event> {
-        self.events.pop_front()
+        self.events.pop()
     }
 
     /// Events dropped because the queue was full when they happened.
     pub fn events_dropped(&self) -> u32 {
-        self.events_dropped
+        self.events.dropped
     }
 
-    #[inline(never)]
+    #[inline(always)]
     fn record(&mut self, tick: u32, kind: EventKind) {
-        if self.events.is_full() {
-            self.events.pop_front();
-            self.events_dropped = self.events_dropped.saturating_add(1);
-        }
-        // Cannot fail: there is room now.
-        let _ = self.events.push_back(Event { tick, kind });
+        self.events.push(Event { tick, kind });
     }
 
     /// Asks for stage 2 (retrieval) to begin at the next step, whatever the configured start.
     pub fn start_stage2(&mut self) {
-        self.stage2_requested = true;
+        if !self.stage2 {
+            self.stage2_due_tick = 0;
+        }
     }
 
     /// One control period with a fresh sensor sample.
@@ -425,16 +476,25 @@ impl<T: Real> Controller<T> {
         let elapsed_ticks = match self.last_tick {
             None => 0,
             Some(last) if tick >= last => tick - last,
-            Some(_) => return self.reject(tick, Fault::Sensor(Sensor::Tick), None, flags, before),
+            Some(_) => {
+                let unmoved = self.length_estimate_m;
+                return self.reject(
+                    tick,
+                    unmoved,
+                    Fault::Sensor(Sensor::Tick),
+                    None,
+                    flags,
+                    before,
+                );
+            }
         };
         let first = self.last_tick.is_none();
         self.last_tick = Some(tick);
         let elapsed_s = T::from_u32(elapsed_ticks) * dt;
-        // Dead reckoning: the reel ran at the last command since the last step (within the
-        // physical range: the reel cannot pay out past its spool nor wind in past zero).
+        // Dead reckoning: the reel ran at the last command since the last step. A valid sample
+        // replaces the prediction; without one it becomes the estimate (see `reject`).
         // (Both terms are finite: the estimate is clamped, the command is inside the envelope.)
-        self.length_estimate_m = (self.length_estimate_m + self.last_rate_cmd_mps * elapsed_s)
-            .clamp_finite(T::ZERO, self.derived.spool_m);
+        let predicted_m = self.length_estimate_m + self.last_rate_cmd_mps * elapsed_s;
 
         // Sequencer: stage 1 starts with the first step; stage 2 at its tick or on command.
         // Each stage restarts the blend from the current rate (SPEC §7).
@@ -442,21 +502,22 @@ impl<T: Real> Controller<T> {
             self.stage_start_tick = tick;
             self.restart_blend(tick, self.cfg.initial_rate_mps, &mut flags);
         }
-        let due = self.cfg.stage2.start_tick.is_some_and(|s| tick >= s);
-        if !self.stage2 && (due || self.stage2_requested) {
+        if u64::from(tick) >= self.stage2_due_tick {
             self.stage2 = true;
+            self.stage2_due_tick = u64::MAX;
             self.stage_start_tick = tick;
             self.restart_blend(tick, self.last_rate_cmd_mps, &mut flags);
             self.phase = Phase::Slew;
         }
 
         let Some(x) = sample else {
-            return self.reject(tick, Fault::Sensor(Sensor::Missing), None, flags, before);
+            let f = Fault::Sensor(Sensor::Missing);
+            return self.reject(tick, predicted_m, f, None, flags, before);
         };
         // Before the first accepted sample, and in safe hold, there is no trusted prediction:
         // the next valid sample (re-)anchors it.
         let expected = if self.anchored && self.health != Health::SafeHold {
-            Some(self.length_estimate_m)
+            Some(predicted_m)
         } else {
             None
         };
@@ -464,7 +525,7 @@ impl<T: Real> Controller<T> {
             .monitor
             .check(&self.cfg.monitor, x, expected, self.derived.spool_m, dt)
         {
-            return self.reject(tick, Fault::Sensor(s), None, flags, before);
+            return self.reject(tick, predicted_m, Fault::Sensor(s), None, flags, before);
         }
         self.length_estimate_m = x.length_m;
         self.anchored = true;
@@ -482,17 +543,22 @@ impl<T: Real> Controller<T> {
         let blend_weight = self.blend_weight(tick);
         let law = match self.solve(x, &reference, mu3, mu3_per_m, blend_weight) {
             Ok(v) => v,
-            Err(f) => return self.reject(tick, Fault::Law(f), Some(&reference), flags, before),
+            Err(f) => {
+                let (sensed, f) = (x.length_m, Fault::Law(f));
+                return self.reject(tick, sensed, f, Some(&reference), flags, before);
+            }
         };
         self.set_health(Health::Nominal, &mut flags);
         self.bad_ticks = 0;
 
         // The first step has no previous period: the envelope judges it over one period.
         let limit_s = if elapsed_ticks == 0 { dt } else { elapsed_s };
-        let (rate, sat) =
-            self.cfg
-                .envelope
-                .limit(law.rate_mps, self.last_rate_cmd_mps, x.length_m, limit_s);
+        let (rate, sat) = self.cfg.envelope.limit_request(
+            law.rate_mps,
+            self.last_rate_cmd_mps,
+            x.length_m,
+            limit_s,
+        );
         let limited = sat != Saturation::default();
         flags.set_if(sat.rate, Flags::RATE_SATURATED);
         flags.set_if(sat.accel, Flags::ACCEL_SATURATED);
@@ -613,15 +679,20 @@ impl<T: Real> Controller<T> {
     }
 
     /// No usable sample or no law solution at this tick: coast (Degraded) for up to
-    /// `coast_ticks`, then safe hold.
+    /// `coast_ticks`, then safe hold. `length_m` becomes the length estimate (the dead-reckoned
+    /// prediction, or the sensed length of a valid sample the law could not use), limited to
+    /// the physical range: the reel cannot pay out past its spool nor wind in past zero.
+    #[allow(clippy::too_many_arguments)]
     fn reject(
         &mut self,
         tick: u32,
+        length_m: T,
         fault: Fault,
         reference: Option<&Reference<T>>,
         mut flags: Flags,
         before: Before,
     ) -> Output<T> {
+        self.length_estimate_m = length_m.clamp_finite(T::ZERO, self.derived.spool_m);
         self.bad_ticks = self.bad_ticks.saturating_add(1);
         let next =
             if self.health == Health::SafeHold || self.bad_ticks > self.cfg.monitor.coast_ticks {
@@ -661,7 +732,7 @@ impl<T: Real> Controller<T> {
         let (rate, sat) = self
             .cfg
             .envelope
-            .limit(target, prev, self.length_estimate_m, dt);
+            .limit_request(target, prev, self.length_estimate_m, dt);
         flags.set_if(sat.length, Flags::LENGTH_LIMITED);
         self.last_rate_cmd_mps = rate;
         let mu3 = self.cfg.masses.mu3_and_slope(self.length_estimate_m).0;

@@ -54,8 +54,27 @@ impl<T: Real> Envelope<T> {
     ///
     /// The result is finite and within ±`max_rate_mps` whenever `previous_mps` is (a NaN
     /// request is treated as a request to keep the previous command).
-    #[inline(always)]
+    #[inline]
     pub fn limit(
+        &self,
+        requested_mps: T,
+        previous_mps: T,
+        length_m: T,
+        dt_s: T,
+    ) -> (T, Saturation) {
+        let requested_mps = if requested_mps.is_nan() {
+            previous_mps
+        } else {
+            requested_mps
+        };
+        self.limit_request(requested_mps, previous_mps, length_m, dt_s)
+    }
+
+    /// [`limit`](Self::limit) for a request that is not NaN: the controller's (the law's
+    /// solution is checked finite, a safe action asks for the previous command or zero), so the
+    /// step does not test it again.
+    #[inline(always)]
+    pub(crate) fn limit_request(
         &self,
         requested_mps: T,
         previous_mps: T,
@@ -64,11 +83,7 @@ impl<T: Real> Envelope<T> {
     ) -> (T, Saturation) {
         let mut sat = Saturation::default();
         let vmax = self.max_rate_mps;
-        let mut y = if requested_mps.is_nan() {
-            previous_mps
-        } else {
-            requested_mps
-        };
+        let mut y = requested_mps;
         if y.abs() > vmax {
             sat.rate = true;
             y = y.clamp_to(-vmax, vmax);
@@ -80,22 +95,23 @@ impl<T: Real> Envelope<T> {
         }
         // Only the length limit ahead of the motion can bind: the spool end when paying out,
         // docking when winding in. Far from it (the braking distance at y, plus two periods,
-        // fits in the room left) the command passes as it is.
+        // fits in the room left) the command passes as it is. (A negative room, past the
+        // limit, is never far for a speed toward it; the braking curve sees it as zero.)
         let guard = T::from_f64(LENGTH_GUARD_REL);
         let two = T::from_f64(2.0);
         let far = |v: T, room: T| v * (v / (two * self.max_accel_mps2) + two * dt_s) <= room;
         let (up, down) = if y > T::ZERO {
-            let up_room = (self.max_length_m * (T::ONE - guard) - length_m).max(T::ZERO);
+            let up_room = self.max_length_m * (T::ONE - guard) - length_m;
             if far(y, up_room) {
                 return (Self::settle(y, vmax, sat), sat);
             }
-            (self.braking_speed(up_room, dt_s), -vmax)
+            (self.braking_speed(up_room.max(T::ZERO), dt_s), -vmax)
         } else if y < T::ZERO {
-            let down_room = (length_m - self.min_length_m * (T::ONE + guard)).max(T::ZERO);
+            let down_room = length_m - self.min_length_m * (T::ONE + guard);
             if far(-y, down_room) {
                 return (Self::settle(y, vmax, sat), sat);
             }
-            (vmax, -self.braking_speed(down_room, dt_s))
+            (vmax, -self.braking_speed(down_room.max(T::ZERO), dt_s))
         } else {
             // Zero (or NaN, when `previous_mps` is: the documented fallback is −vmax).
             return (y.clamp_to(-vmax, vmax), sat);

@@ -19,9 +19,10 @@
 //!
 //! [`exp`] (the Eq. 29 blend weight e^{−cτ}, once per step) is the Cephes `expf` scheme without
 //! libm's general-purpose special-casing: k = round(x/ln 2), r = x − k·ln 2 in two parts, a
-//! degree-7 polynomial for e^r on |r| ≤ ln 2 / 2, and 2^k put into the exponent bits. Within two
-//! ulps of the correctly rounded e^x over the whole range where e^x is a normal f32 (proven by
-//! this module's tests on every 64th f32 of that range); outside it, libm's answer.
+//! degree-7 polynomial for e^r on |r| ≤ ln 2 / 2, and 2^k put into the exponent bits, on the
+//! decay range −87 ≤ x ≤ −0 that the blend uses. Within two ulps of the correctly rounded e^x
+//! there (proven by this module's tests on every 32nd f32 of that range); elsewhere, libm's
+//! answer.
 //!
 //! Rounding to an integer uses the classic `(v + 1.5·2²³) − 1.5·2²³`, which the FPU rounds to
 //! nearest-even exactly as `rintf` does for |v| < 2²² (LLVM keeps the pair: no fast-math).
@@ -57,7 +58,7 @@ fn round_small(v: f32) -> f32 {
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a <= b)` is meant: it is true for NaN.
 pub fn sin_cos(x: f32) -> (f32, f32) {
     // NaN fails the comparison: NaN, ±inf and huge arguments get libm's answer.
-    if !(libm::fabsf(x) <= FAST_RANGE) {
+    if !(x.abs() <= FAST_RANGE) {
         return (libm::sinf(x), libm::cosf(x));
     }
     // |x·2/π| ≤ 5 216 < 2²².
@@ -81,12 +82,18 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
 /// normal positive x; zero, subnormals, infinities, negatives and NaN go to libm.
 #[inline]
 pub fn sqrt(x: f32) -> f32 {
-    let normal = (f32::MIN_POSITIVE..=f32::MAX).contains(&x);
-    if !normal {
+    // One unsigned comparison selects the positive normals: their bit patterns are the
+    // contiguous range [MIN_POSITIVE, MAX]; zero, subnormals, infinities, negatives and NaN
+    // all fall outside it.
+    const LOWEST: u32 = f32::MIN_POSITIVE.to_bits();
+    const SPAN: u32 = f32::MAX.to_bits() - LOWEST;
+    let bits = x.to_bits();
+    if bits.wrapping_sub(LOWEST) > SPAN {
         return libm::sqrtf(x);
     }
     let h = 0.5 * x;
-    let mut r = f32::from_bits(0x5f37_5a86 - (x.to_bits() >> 1));
+    // bits < 0x7f80_0000: no wrap-around.
+    let mut r = f32::from_bits(0x5f37_5a86_u32.wrapping_sub(bits >> 1));
     r = r * (1.5 - h * r * r);
     r = r * (1.5 - h * r * r);
     let s = x * r;
@@ -95,8 +102,6 @@ pub fn sqrt(x: f32) -> f32 {
 
 /// Smallest argument of the fast [`exp`]: e^x stays a normal f32 above it.
 pub const EXP_FAST_MIN: f32 = -87.0;
-/// Largest argument of the fast [`exp`]: k = round(x/ln 2) ≤ 127 below it.
-pub const EXP_FAST_MAX: f32 = 88.0;
 
 const LOG2_E: f32 = core::f32::consts::LOG2_E;
 // ln 2 = L1 + L2 (Cephes: L1 = 0.693359375 has 9 significant bits, so k·L1 is exact).
@@ -111,17 +116,23 @@ const E4: f32 = 1.398_2e-3;
 const E5: f32 = 1.987_569_1e-4;
 
 /// e^x in single precision (see the module docs for the accuracy).
+///
+/// The fast path is the decay range [`EXP_FAST_MIN`] ≤ x ≤ −0 (the Eq. 29 blend weight
+/// e^{−cτ} is always there), selected by one unsigned comparison of the bit pattern: the
+/// negative floats from −0 to −87 are one contiguous range of patterns. Everything else
+/// (+0, positive arguments, results below the normal range, infinities, NaN) is libm's.
 #[inline]
 pub fn exp(x: f32) -> f32 {
-    // NaN fails both comparisons: NaN, ±inf, overflow and subnormal results go to libm.
-    if !(EXP_FAST_MIN..=EXP_FAST_MAX).contains(&x) {
+    const NEG_ZERO: u32 = 0x8000_0000;
+    const SPAN: u32 = EXP_FAST_MIN.to_bits() - NEG_ZERO;
+    if x.to_bits().wrapping_sub(NEG_ZERO) > SPAN {
         return libm::expf(x);
     }
-    // |x/ln 2| < 128: k is exact and −126 ≤ k ≤ 127, so 2^k is a normal f32.
+    // −126 < x/ln 2 ≤ 0: k is exact and −126 ≤ k ≤ 0, so 2^k is a normal f32.
     let k = round_small(x * LOG2_E);
     let r = (x - k * L1) - k * L2;
     let p = 1.0 + r + r * r * (E0 + r * (E1 + r * (E2 + r * (E3 + r * (E4 + r * E5)))));
-    let two_to_k = f32::from_bits(((k as i32 + 127) as u32) << 23);
+    let two_to_k = f32::from_bits(((k as i32).wrapping_add(127) as u32) << 23);
     p * two_to_k
 }
 
@@ -212,13 +223,13 @@ mod tests {
 
     #[test]
     fn exp_is_within_two_ulps_over_its_fast_range() {
-        // Every 64th f32 in [−87, 88] (≈ 34 million arguments), against f64 e^x rounded.
+        // Every 32nd f32 in [−87, −0] (≈ 34 million arguments), against f64 e^x rounded, and
+        // every 64th positive one up to 88 (libm's path).
         let mut worst = (0, 0.0_f32);
-        let top = EXP_FAST_MAX.to_bits();
         let bottom = EXP_FAST_MIN.to_bits();
-        let pos = (0..=top).step_by(64);
-        let neg = (0x8000_0000..=bottom).step_by(64);
-        for bits in pos.chain(neg) {
+        let neg = (0x8000_0000..=bottom).step_by(32);
+        let pos = (0..=88.0_f32.to_bits()).step_by(64);
+        for bits in neg.chain(pos) {
             let x = f32::from_bits(bits);
             let u = ulps(exp(x), libm::exp(f64::from(x)));
             if u > worst.0 {
@@ -233,7 +244,9 @@ mod tests {
         assert_eq!(exp(0.0), 1.0);
         assert_eq!(exp(-0.0), 1.0);
         for x in [
-            -87.000_01_f32,
+            0.0_f32,
+            1.0,
+            -87.000_01,
             -100.0,
             -104.0,
             88.000_01,
@@ -248,7 +261,7 @@ mod tests {
         }
         assert!(exp(f32::NAN).is_nan());
         // Just inside the fast range at both ends: normal results, within two ulps.
-        for x in [EXP_FAST_MIN, EXP_FAST_MAX] {
+        for x in [EXP_FAST_MIN, -0.0, -f32::MIN_POSITIVE, -1e-30] {
             assert!(exp(x).is_normal());
             assert!(ulps(exp(x), libm::exp(f64::from(x))) <= 2, "{x}");
         }

@@ -147,7 +147,7 @@ impl Real for f32 {
     }
     #[inline]
     fn abs(self) -> Self {
-        libm::fabsf(self)
+        f32::abs(self)
     }
     #[inline]
     fn floor(self) -> Self {
@@ -204,7 +204,7 @@ impl Real for f64 {
     }
     #[inline]
     fn abs(self) -> Self {
-        libm::fabs(self)
+        f64::abs(self)
     }
     #[inline]
     fn floor(self) -> Self {

@@ -7,10 +7,17 @@ ticks, and attributes every instruction of tick N to the source function it came
 the inlining chain (llvm-symbolizer --inlining). So the breakdown is that of the flight codegen,
 with everything LLVM inlined into `Controller::step` sorted back into the paper's pieces.
 
-    tools/trace_profile.py [--elf ELF] [--tick N] [--top K] [--lines [--within REGEX]]
+    tools/trace_profile.py [--elf ELF] [--tick N | --mission-tick N] [--top K]
+                           [--lines [--within REGEX]]
 
 --lines adds the instructions per source line (innermost frame, with its inlining chain);
 --within REGEX keeps only the lines of the categories matching REGEX (e.g. "Monitor").
+
+--mission-tick N profiles step N of the whole 20-h paper mission instead: the subject is
+examples/trace_step.rs (one `Controller::step` a tick, built with the flight profile:
+`cargo build --profile firmware --target thumbv7em-none-eabihf --example trace_step`), and the
+instructions counted are those from the N-th entry into `Controller::advance` to the return to
+the caller. The trace is streamed through a pipe, not stored (a late tick is ~10^8 lines).
 
 Defaults: the flight firmware (target/thumbv7em-none-eabihf/firmware/tss-reel, build it with
 `cargo fw-build`), tick 301 (a nominal deploy step that logs nothing). Needs qemu-system-arm
@@ -61,34 +68,94 @@ def main():
                     help="also count instructions per source line (innermost frame)")
     ap.add_argument("--within", default="",
                     help="with --lines: only instructions whose category matches this regex")
+    ap.add_argument("--mission-tick", type=int, default=None,
+                    help="profile step N of the paper mission (examples/trace_step.rs)")
     a = ap.parse_args()
+    if a.mission_tick is not None:
+        if a.elf == ap.get_default("elf"):
+            a.elf = "target/thumbv7em-none-eabihf/firmware/examples/trace_step"
+        pcs = mission_step_pcs(a.elf, a.mission_tick)
+        what = f"mission step {a.mission_tick}: {len(pcs)} instructions, Controller::advance entry to return"
+    else:
+        pcs = firmware_tick_pcs(a.elf, a.tick)
+        what = f"tick {a.tick}: {len(pcs)} instructions, SysTick entry to SysTick entry"
+    profile(a, pcs, what)
 
+
+QEMU = ["qemu-system-arm", "-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic",
+        "-semihosting-config", "enable=on,target=native",
+        "-icount", "shift=5,align=off,sleep=off", "-singlestep", "-d", "exec,nochain"]
+PC = re.compile(r"Trace \d+: \S+ \[[0-9a-f]+/([0-9a-f]+)/")
+
+
+def mission_step_pcs(elf, n):
+    """The PCs of the n-th call of Controller::advance (n counts from 0), read from a pipe:
+    from its entry to the return to the caller (the instruction after the caller's `bl`)."""
+    nm = subprocess.run(["llvm-nm", "--defined-only", elf], capture_output=True,
+                        text=True, check=True).stdout
+    entries = [int(l.split()[0], 16) & ~1 for l in nm.splitlines()
+               if "Controller" in l and "advance" in l]
+    if len(entries) != 1:
+        sys.exit(f"trace_profile: expected one Controller::advance in {elf}, found {len(entries)}")
+    entry = entries[0]
+    with tempfile.TemporaryDirectory() as tmp:
+        fifo = os.path.join(tmp, "trace.fifo")
+        os.mkfifo(fifo)
+        qemu = subprocess.Popen(QEMU + ["-D", fifo, "-kernel", elf],
+                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL)
+        pcs, calls, prev, ret = [], -1, None, None
+        try:
+            with open(fifo) as f:
+                for line in f:
+                    m = PC.match(line)
+                    if not m:
+                        continue
+                    pc = int(m.group(1), 16)
+                    if pc == entry:
+                        calls += 1
+                        if calls == n:
+                            ret = prev + 4  # after the caller's 32-bit `bl`
+                    if ret is not None:
+                        if pc == ret:
+                            break
+                        pcs.append(pc)
+                    prev = pc
+        finally:
+            qemu.kill()
+            qemu.wait()
+    if not pcs:
+        sys.exit(f"trace_profile: mission step {n} not reached")
+    return pcs
+
+
+def firmware_tick_pcs(elf, tick):
+    """The PCs of control tick `tick` of the firmware: SysTick entry to the next one."""
     with tempfile.TemporaryDirectory() as tmp:
         log = os.path.join(tmp, "trace.log")
-        subprocess.run(
-            ["qemu-system-arm", "-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic",
-             "-semihosting-config", "enable=on,target=native",
-             "-icount", "shift=5,align=off,sleep=off", "-singlestep", "-d", "exec,nochain",
-             "-D", log, "-kernel", a.elf],
-            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, check=True, timeout=600)
-        pcs, ticks, prev, inside = [], -1, None, False
-        pat = re.compile(r"Trace \d+: \S+ \[[0-9a-f]+/([0-9a-f]+)/")
+        subprocess.run(QEMU + ["-D", log, "-kernel", elf],
+                       stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, check=True,
+                       timeout=600)
+        pcs, ticks, prev = [], -1, None
         with open(log) as f:
             for line in f:
-                m = pat.match(line)
+                m = PC.match(line)
                 if not m:
                     continue
                 name = line.rsplit("]", 1)[1].strip()
                 if name == "SysTick" and prev != "SysTick":
                     ticks += 1
-                    if ticks == a.tick + 1:
+                    if ticks == tick + 1:
                         break
                 prev = name
-                if ticks == a.tick:
+                if ticks == tick:
                     pcs.append(int(m.group(1), 16))
     if not pcs:
-        sys.exit(f"trace_profile: tick {a.tick} not reached")
+        sys.exit(f"trace_profile: tick {tick} not reached")
+    return pcs
 
+
+def profile(a, pcs, what):
+    """Prints the instructions of `pcs` by category, innermost function and source line."""
     # Function extents, to follow calls into functions LLVM kept out of line (libm's sqrtf,
     # expf, the compiler's soft-float helpers): a shadow call stack over the trace.
     nm = subprocess.run(["llvm-nm", "-S", "--defined-only", a.elf], capture_output=True,
@@ -128,7 +195,7 @@ def main():
         if re.search(a.within, cat):
             by_line[where[pc] + "  [" + " < ".join(chains[pc][:3]) + "]"] += 1
     total = len(pcs)
-    print(f"{a.elf}: tick {a.tick}: {total} instructions, SysTick entry to SysTick entry")
+    print(f"{a.elf}: {what}")
     for cat, n in by_cat.most_common():
         print(f"  {n:6d}  {100 * n / total:5.1f} %  {cat}")
     print(f"innermost source functions (top {a.top}):")
