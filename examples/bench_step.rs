@@ -75,7 +75,7 @@ mod bench {
     use cortex_m::peripheral::{syst::SystClkSource, SYST};
     use tss_reel::controller::{Config, Controller, Health, Input, Output, Phase};
     use tss_reel::equilibrium::ExistenceMonitor;
-    use tss_reel::law::{self, LawInput};
+    use tss_reel::law::{self, Blend, LawInput};
     use tss_reel::schedule::{PreparedBand, Reference};
 
     /// Copies of the state each measurement runs on; the result is divided by this.
@@ -378,7 +378,7 @@ mod bench {
             ref_time_rate_radps: reference.time_rate_radps,
             mu3: masses.mu3_and_slope(l).0,
             mu3_per_m: masses.mu3_and_slope(l).1,
-            blend_weight: out.blend_weight,
+            blend: Blend::decayed(libm::logf(out.blend_weight.max(f32::MIN_POSITIVE))),
             decay_rate_per_s: decay,
             initial_rate_mps: initial,
             gains: cfg.gains,
@@ -391,7 +391,7 @@ mod bench {
         };
         // The blend's argument −cτ, recovered from the reported weight.
         let exponent = libm::logf(out.blend_weight.max(f32::MIN_POSITIVE));
-        let blend = m.pure(exponent, |&e| tss_reel::fastmath::exp(e));
+        let blend = m.pure(exponent, |&e| Blend::decayed(e));
         let mass = m.pure(l, |&l| masses.mu3_and_slope(l));
         let mu3 = law_in.mu3;
         let rate = out.rate_cmd_mps;

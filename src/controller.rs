@@ -25,7 +25,7 @@
 
 use crate::envelope::Saturation;
 use crate::equilibrium::ExistenceMonitor;
-use crate::law::{self, LawFault, LawInput};
+use crate::law::{self, Blend, LawFault, LawInput};
 use crate::monitor::{Monitor, SPOOL_MARGIN};
 use crate::real::Real;
 use crate::schedule::{PreparedBand, Reference};
@@ -105,11 +105,11 @@ pub struct Flags(pub u32);
 
 impl Flags {
     /// The law asked for more than the rate limit.
-    pub const RATE_SATURATED: u32 = 1 << 0;
+    pub const RATE_SATURATED: u32 = Saturation::RATE;
     /// The change from the previous command exceeded the acceleration limit.
-    pub const ACCEL_SATURATED: u32 = 1 << 1;
+    pub const ACCEL_SATURATED: u32 = Saturation::ACCEL;
     /// A length limit (docking or spool) restricted the command.
-    pub const LENGTH_LIMITED: u32 = 1 << 2;
+    pub const LENGTH_LIMITED: u32 = Saturation::LENGTH;
     /// The command is a safe action, not the law's value (see [`Output::fault`]).
     pub const SAFE_ACTION: u32 = 1 << 3;
     /// The blend (Eq. 29) restarted at this step (a stage began, or the controller recovered).
@@ -241,13 +241,14 @@ impl EventRing {
     #[inline(always)]
     fn push(&mut self, e: Event) {
         const MASK: usize = EVENT_CAPACITY - 1;
+        // head, len ≤ EVENT_CAPACITY: no wrap-around; when full the slot is the oldest's.
+        self.buf[self.head.wrapping_add(self.len) & MASK] = e;
         if self.len == EVENT_CAPACITY {
-            self.head = (self.head + 1) & MASK;
+            self.head = self.head.wrapping_add(1) & MASK;
             self.dropped = self.dropped.saturating_add(1);
         } else {
-            self.len += 1;
+            self.len = self.len.wrapping_add(1);
         }
-        self.buf[(self.head + self.len - 1) & MASK] = e;
     }
 
     /// Takes the oldest unread event.
@@ -264,6 +265,10 @@ impl EventRing {
 
 /// Bound on the reported [`Output::equilibrium_margin`] (x grows as 1/l toward docking).
 pub const MAX_REPORTED_MARGIN: f64 = 1e6;
+
+/// Largest |x| (normalised rate) whose margin a step reports without bounding it: the margin
+/// is then at most |x| + the existence region's width, well inside [`MAX_REPORTED_MARGIN`].
+const MODERATE_NORMALISED_RATE: f64 = 1e5;
 
 /// The reel controller (see the module docs for a complete example).
 #[derive(Clone, Debug)]
@@ -540,8 +545,8 @@ impl<T: Real> Controller<T> {
             self.restart_blend(tick, self.last_rate_cmd_mps, &mut flags);
         }
         let (mu3, mu3_per_m) = self.cfg.masses.mu3_and_slope(x.length_m);
-        let blend_weight = self.blend_weight(tick);
-        let law = match self.solve(x, &reference, mu3, mu3_per_m, blend_weight) {
+        let blend = self.blend(tick);
+        let law = match self.solve(x, &reference, mu3, mu3_per_m, blend) {
             Ok(v) => v,
             Err(f) => {
                 let (sensed, f) = (x.length_m, Fault::Law(f));
@@ -559,10 +564,8 @@ impl<T: Real> Controller<T> {
             x.length_m,
             limit_s,
         );
-        let limited = sat != Saturation::default();
-        flags.set_if(sat.rate, Flags::RATE_SATURATED);
-        flags.set_if(sat.accel, Flags::ACCEL_SATURATED);
-        flags.set_if(sat.length, Flags::LENGTH_LIMITED);
+        let limited = sat.any();
+        flags.set(sat.0);
         flags.set_if(law.reference.slewing, Flags::SLEWING);
         let accel = if limited {
             (rate - self.last_rate_cmd_mps) / limit_s
@@ -580,7 +583,7 @@ impl<T: Real> Controller<T> {
             rate_cmd_mps: rate,
             accel_cmd_mps2: accel,
             law_rate_mps: law.law_rate_mps,
-            blend_weight,
+            blend_weight: blend.weight,
             alpha_ref_rad: law.reference.angle.angle_rad,
             alpha_ref_rate_radps: law.ref_rate_radps,
             delta_rad: law.delta_rad,
@@ -605,27 +608,36 @@ impl<T: Real> Controller<T> {
         self.derived.decay_rate_per_s[usize::from(self.stage2)]
     }
 
-    /// E = e^{−cτ}, τ = k·Δt the time since the blend (re)started k ticks ago (Eq. 29).
+    /// E = e^{−cτ} and 1 − E, τ = k·Δt the time since the blend (re)started k ticks ago
+    /// (Eq. 29).
     #[inline(always)]
-    fn blend_weight(&self, tick: u32) -> T {
+    fn blend(&self, tick: u32) -> Blend<T> {
         let k = T::from_u32(tick.saturating_sub(self.blend_start_tick));
-        (self.derived.neg_decay_per_tick[usize::from(self.stage2)] * k).exp()
+        Blend::decayed(self.derived.neg_decay_per_tick[usize::from(self.stage2)] * k)
     }
 
-    /// α_r and its derivatives at this tick and length (Eq. 34, or Eq. 35 with the slew).
+    /// α_r and its derivatives at this tick and length: Eq. 34 in stage 1; in stage 2, the
+    /// slew from the stage's start until it first meets Eq. 35 ([`Phase::Slew`]), then Eq. 35.
+    /// (The slew is over for good once met: the phase never returns to `Slew`.)
     #[inline(always)]
     fn reference(&self, tick: u32, length_m: T) -> Reference<T> {
-        if self.stage2 {
+        if self.phase == Phase::Slew {
             let tau_s = T::from_u32(tick.saturating_sub(self.stage_start_tick)) * self.cfg.period_s;
-            self.derived
-                .stage2
-                .eval_slewed(self.cfg.stage2.slew_rate_radps, tau_s, length_m)
+            return self.derived.stage2.eval_slewed(
+                self.cfg.stage2.slew_rate_radps,
+                tau_s,
+                length_m,
+            );
+        }
+        let band = if self.stage2 {
+            &self.derived.stage2
         } else {
-            Reference {
-                angle: self.derived.stage1.eval(length_m),
-                time_rate_radps: T::ZERO,
-                slewing: false,
-            }
+            &self.derived.stage1
+        };
+        Reference {
+            angle: band.eval(length_m),
+            time_rate_radps: T::ZERO,
+            slewing: false,
         }
     }
 
@@ -636,7 +648,7 @@ impl<T: Real> Controller<T> {
         reference: &Reference<T>,
         mu3: T,
         mu3_per_m: T,
-        blend_weight: T,
+        blend: Blend<T>,
     ) -> Result<LawPart<T>, LawFault> {
         let law_in = LawInput {
             length_m: x.length_m,
@@ -649,7 +661,7 @@ impl<T: Real> Controller<T> {
             ref_time_rate_radps: reference.time_rate_radps,
             mu3,
             mu3_per_m,
-            blend_weight,
+            blend,
             decay_rate_per_s: self.decay_rate_per_s(),
             initial_rate_mps: self.blend_initial_rate_mps,
             gains: self.cfg.gains,
@@ -733,7 +745,7 @@ impl<T: Real> Controller<T> {
             .cfg
             .envelope
             .limit_request(target, prev, self.length_estimate_m, dt);
-        flags.set_if(sat.length, Flags::LENGTH_LIMITED);
+        flags.set(sat.0 & Flags::LENGTH_LIMITED);
         self.last_rate_cmd_mps = rate;
         let mu3 = self.cfg.masses.mu3_and_slope(self.length_estimate_m).0;
         let margin = self.equilibrium_margin(mu3, self.length_estimate_m, rate, &mut flags);
@@ -745,7 +757,7 @@ impl<T: Real> Controller<T> {
             rate_cmd_mps: rate,
             accel_cmd_mps2: (rate - prev) / dt,
             law_rate_mps: T::ZERO,
-            blend_weight: self.blend_weight(tick),
+            blend_weight: self.blend(tick).weight,
             alpha_ref_rad: reference.angle.angle_rad,
             alpha_ref_rate_radps: T::ZERO,
             delta_rad: T::ZERO,
@@ -758,21 +770,36 @@ impl<T: Real> Controller<T> {
     }
 
     /// The Eq. 13 margin of the command (whole orbit), flagging a command outside the region.
+    ///
+    /// The common case takes one comparison: a normalised rate x of moderate size, whose
+    /// margin is within the reported bound as it is (|margin| ≤ |x| + the extent's width, far
+    /// below [`MAX_REPORTED_MARGIN`]). NaN, infinities and huge values (a length estimate
+    /// near zero) fail it and take [`Self::far_equilibrium_margin`].
     #[inline(always)]
     fn equilibrium_margin(&self, mu3: T, length_m: T, rate_mps: T, flags: &mut Flags) -> T {
+        let x = self.existence.normalised_rate(mu3, length_m, rate_mps);
+        let (margin, outside) = if x.abs() <= T::from_f64(MODERATE_NORMALISED_RATE) {
+            let m = self.existence.whole_orbit_margin_of(x);
+            (m, m < T::ZERO)
+        } else {
+            self.far_equilibrium_margin(mu3, length_m, rate_mps)
+        };
+        flags.set_if(outside, Flags::NO_EQUILIBRIUM);
+        margin
+    }
+
+    /// [`Self::equilibrium_margin`] beyond the moderate range: (margin, outside the region).
+    #[inline(never)]
+    fn far_equilibrium_margin(&self, mu3: T, length_m: T, rate_mps: T) -> (T, bool) {
         match self.existence.whole_orbit_margin(mu3, length_m, rate_mps) {
             Some(margin) => {
-                flags.set_if(margin < T::ZERO, Flags::NO_EQUILIBRIUM);
                 // x grows as 1/l: near docking the margin can exceed f32; report it bounded.
                 let bound = T::from_f64(MAX_REPORTED_MARGIN);
-                margin.clamp_finite(-bound, bound)
+                (margin.clamp_finite(-bound, bound), margin < T::ZERO)
             }
             // Only a non-positive length estimate gets here (a long coast toward docking): no
             // equilibrium statement can be made.
-            None => {
-                flags.set(Flags::NO_EQUILIBRIUM);
-                T::ZERO
-            }
+            None => (T::ZERO, true),
         }
     }
 

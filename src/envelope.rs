@@ -37,15 +37,36 @@ pub struct Envelope<T> {
     pub max_length_m: T,
 }
 
-/// Which limits acted on a command.
+/// Which limits acted on a command: a set of bits, so that a step merges them into its status
+/// flags with one OR ([`Saturation::RATE`], [`Saturation::ACCEL`] and [`Saturation::LENGTH`]
+/// are the controller's `Flags` bits of the same names).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Saturation {
-    /// The speed limit.
-    pub rate: bool,
-    /// The acceleration limit.
-    pub accel: bool,
-    /// A length limit (docking or spool).
-    pub length: bool,
+pub struct Saturation(pub u32);
+
+impl Saturation {
+    /// The speed limit acted.
+    pub const RATE: u32 = 1 << 0;
+    /// The acceleration limit acted.
+    pub const ACCEL: u32 = 1 << 1;
+    /// A length limit (docking or spool) acted.
+    pub const LENGTH: u32 = 1 << 2;
+
+    /// The speed limit acted.
+    pub fn rate(self) -> bool {
+        self.0 & Self::RATE != 0
+    }
+    /// The acceleration limit acted.
+    pub fn accel(self) -> bool {
+        self.0 & Self::ACCEL != 0
+    }
+    /// A length limit acted.
+    pub fn length(self) -> bool {
+        self.0 & Self::LENGTH != 0
+    }
+    /// Some limit acted.
+    pub fn any(self) -> bool {
+        self.0 != 0
+    }
 }
 
 impl<T: Real> Envelope<T> {
@@ -85,12 +106,12 @@ impl<T: Real> Envelope<T> {
         let vmax = self.max_rate_mps;
         let mut y = requested_mps;
         if y.abs() > vmax {
-            sat.rate = true;
+            sat.0 |= Saturation::RATE;
             y = y.clamp_to(-vmax, vmax);
         }
         let dv = self.max_accel_mps2 * dt_s;
         if (y - previous_mps).abs() > dv {
-            sat.accel = true;
+            sat.0 |= Saturation::ACCEL;
             y = y.clamp_to(previous_mps - dv, previous_mps + dv);
         }
         // Only the length limit ahead of the motion can bind: the spool end when paying out,
@@ -117,7 +138,7 @@ impl<T: Real> Envelope<T> {
             return (y.clamp_to(-vmax, vmax), sat);
         };
         if y > up || y < down {
-            sat.length = true;
+            sat.0 |= Saturation::LENGTH;
             y = y.clamp_to(down, up);
             let guard_m = self.max_length_m * guard;
             let (lo, hi) = (previous_mps - dv, previous_mps + dv);
@@ -134,7 +155,7 @@ impl<T: Real> Envelope<T> {
     /// acceleration clamp moved it (toward a `previous_mps` that could lie outside).
     #[inline(always)]
     fn settle(y: T, vmax: T, sat: Saturation) -> T {
-        if sat.accel {
+        if sat.accel() {
             y.clamp_finite(-vmax, vmax)
         } else {
             y
@@ -179,10 +200,10 @@ mod tests {
     fn speed_then_acceleration() {
         let (y, s) = env().limit(30.0, 9.95, 20_000.0, 1.0);
         assert_eq!(y, 10.0);
-        assert!(s.rate && !s.accel);
+        assert!(s.rate() && !s.accel());
         let (y, s) = env().limit(-3.0, 2.0, 20_000.0, 1.0);
         assert!((y - 1.9).abs() < 1e-12);
-        assert!(s.accel && !s.rate);
+        assert!(s.accel() && !s.rate());
     }
 
     #[test]
@@ -194,7 +215,7 @@ mod tests {
         let m = ((0.25 + 2.0 * d / 0.1_f64).sqrt() - 0.5).floor();
         assert_eq!(m, 31.0);
         let expect = (d + 0.1 * m * (m + 1.0) / 2.0) / (m + 1.0);
-        assert!((y - expect).abs() < 1e-12 && s.length, "{y} vs {expect}");
+        assert!((y - expect).abs() < 1e-12 && s.length(), "{y} vs {expect}");
         // At the limit nothing more goes out, but winding in is allowed.
         assert_eq!(env().limit(1.0, 0.0, 40_000.0, 1.0).0, 0.0);
         assert_eq!(env().limit(-0.05, 0.0, 40_000.0, 1.0).0, -0.05);
@@ -204,7 +225,7 @@ mod tests {
     fn docking_limit_holds() {
         let (y, s) = env().limit(-1.0, -0.1, 0.6, 1.0);
         assert!(
-            s.length && y >= -0.1 - 1e-12 && 0.6 + y >= 0.5 - 1e-12,
+            s.length() && y >= -0.1 - 1e-12 && 0.6 + y >= 0.5 - 1e-12,
             "{y}"
         );
     }

@@ -477,26 +477,45 @@ impl<T: Real> ExistenceMonitor<T> {
         })
     }
 
-    /// The signed whole-orbit (Eq. 13) margin of [`check_rate`](Self::check_rate) alone, for
-    /// the controller's every step: min(min Depl − x, x − max Retr) with x = (2 + μ3) l̇/(ω l),
-    /// ≥ 0 exactly when an equilibrium exists over the whole orbit. `None` when l ≤ 0 or x is
-    /// not finite (where `check_rate` returns an error).
+    /// x = (2 + μ3) l̇/(ω l) (Eq. 7's normalised rate) of a reel at length `length_m` (m)
+    /// running at `length_rate_mps` (m/s), with this orbit's ω. Not finite when l = 0.
+    #[inline(always)]
+    pub fn normalised_rate(&self, mu3: T, length_m: T, length_rate_mps: T) -> T {
+        normalised_rate(mu3, length_rate_mps / length_m, self.mean_motion_radps)
+    }
+
+    /// The signed whole-orbit (Eq. 13) margin of a finite normalised rate `x`:
+    /// min(min Depl − x, x − max Retr), ≥ 0 exactly when an equilibrium exists over the whole
+    /// orbit.
+    #[inline(always)]
+    pub fn whole_orbit_margin_of(&self, x: T) -> T {
+        let (above, below) = (
+            self.extent.min_depl.value - x,
+            x - self.extent.max_retr.value,
+        );
+        // Both finite: a plain comparison is the minimum.
+        if below < above {
+            below
+        } else {
+            above
+        }
+    }
+
+    /// The signed whole-orbit (Eq. 13) margin of [`check_rate`](Self::check_rate) alone:
+    /// [`whole_orbit_margin_of`](Self::whole_orbit_margin_of) the
+    /// [`normalised_rate`](Self::normalised_rate). `None` when l ≤ 0 or x is not finite (where
+    /// `check_rate` returns an error).
     #[inline]
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(l > 0)` is meant: it is true for NaN.
     pub fn whole_orbit_margin(&self, mu3: T, length_m: T, length_rate_mps: T) -> Option<T> {
         if !(length_m > T::ZERO) {
             return None;
         }
-        let x = normalised_rate(mu3, length_rate_mps / length_m, self.mean_motion_radps);
+        let x = self.normalised_rate(mu3, length_m, length_rate_mps);
         if !x.is_finite() {
             return None;
         }
-        let (above, below) = (
-            self.extent.min_depl.value - x,
-            x - self.extent.max_retr.value,
-        );
-        // Both finite: a plain comparison is the minimum.
-        Some(if below < above { below } else { above })
+        Some(self.whole_orbit_margin_of(x))
     }
 
     /// [`check`](Self::check) from the reel's length l (m, > 0) and rate l̇ (m/s).

@@ -116,24 +116,39 @@ const E4: f32 = 1.398_2e-3;
 const E5: f32 = 1.987_569_1e-4;
 
 /// e^x in single precision (see the module docs for the accuracy).
-///
-/// The fast path is the decay range [`EXP_FAST_MIN`] ≤ x ≤ −0 (the Eq. 29 blend weight
-/// e^{−cτ} is always there), selected by one unsigned comparison of the bit pattern: the
-/// negative floats from −0 to −87 are one contiguous range of patterns. Everything else
-/// (+0, positive arguments, results below the normal range, infinities, NaN) is libm's.
 #[inline]
 pub fn exp(x: f32) -> f32 {
+    exp_and_complement(x).0
+}
+
+/// (e^x, 1 − e^x) in single precision, each within a few ulps of its own correctly rounded
+/// value: the complement is not computed from the rounded e^x, so it keeps its relative
+/// precision where e^x ≈ 1 (1 − fl(e^x) would lose it to cancellation: for x = −5·10⁻⁴ the
+/// relative error of 1 − fl(e^x) is 6·10⁻⁵). The Eq. 29 blend needs both E = e^{−cτ} and
+/// 1 − E, and right after the blend (re)starts E is that close to 1.
+///
+/// The fast path is the decay range [`EXP_FAST_MIN`] ≤ x ≤ −0 (the blend's argument −cτ is
+/// always there), selected by one unsigned comparison of the bit pattern: the negative floats
+/// from −0 to −87 are one contiguous range of patterns. Everything else (+0, positive
+/// arguments, results below the normal range, infinities, NaN) is libm's.
+#[inline]
+pub fn exp_and_complement(x: f32) -> (f32, f32) {
     const NEG_ZERO: u32 = 0x8000_0000;
     const SPAN: u32 = EXP_FAST_MIN.to_bits() - NEG_ZERO;
     if x.to_bits().wrapping_sub(NEG_ZERO) > SPAN {
-        return libm::expf(x);
+        return (libm::expf(x), -libm::expm1f(x));
     }
     // −126 < x/ln 2 ≤ 0: k is exact and −126 ≤ k ≤ 0, so 2^k is a normal f32.
     let k = round_small(x * LOG2_E);
     let r = (x - k * L1) - k * L2;
-    let p = 1.0 + r + r * r * (E0 + r * (E1 + r * (E2 + r * (E3 + r * (E4 + r * E5)))));
+    // q = e^r − 1, |q| < 0.42.
+    let q = r + r * r * (E0 + r * (E1 + r * (E2 + r * (E3 + r * (E4 + r * E5)))));
     let two_to_k = f32::from_bits(((k as i32).wrapping_add(127) as u32) << 23);
-    p * two_to_k
+    // e^x = 2^k + 2^k q and 1 − e^x = (1 − 2^k) − 2^k q: 2^k q is exact, 1 − 2^k is exact for
+    // k ≥ −24 (and rounds to 1 below, where 2^k is below half an ulp of the result), so each
+    // is one rounding from its value. For k = 0 the complement is −q: no cancellation.
+    let scaled_q = two_to_k * q;
+    (two_to_k + scaled_q, (1.0 - two_to_k) - scaled_q)
 }
 
 /// sin x in single precision.
@@ -237,6 +252,37 @@ mod tests {
             }
         }
         assert!(worst.0 <= 2, "{} ulps at x = {:e}", worst.0, worst.1);
+    }
+
+    #[test]
+    fn complement_is_within_a_few_ulps_of_one_minus_exp() {
+        // Every 32nd f32 in [−87, −0]: 1 − e^x against the f64 value, in ulps of its own size
+        // (it is never 0 there: the smallest, at x = −2⁻¹⁴⁹, is 2⁻¹⁴⁹ itself).
+        let mut worst = (0, 0.0_f32);
+        for bits in (0x8000_0000..=EXP_FAST_MIN.to_bits()).step_by(32) {
+            let x = f32::from_bits(bits);
+            let (e, c) = exp_and_complement(x);
+            let u = ulps(c, -libm::expm1(f64::from(x)));
+            if u > worst.0 {
+                worst = (u, x);
+            }
+            assert_eq!(e.to_bits(), exp(x).to_bits());
+        }
+        assert!(worst.0 <= 2, "{} ulps at x = {:e}", worst.0, worst.1);
+        // The case of the blend restart: e^x ≈ 1.
+        let x = -5.0e-4_f32;
+        let c = exp_and_complement(x).1;
+        let exact = -libm::expm1(f64::from(x));
+        assert!(
+            (f64::from(c) - exact).abs() <= 1e-7 * exact,
+            "{c} vs {exact}"
+        );
+        // Outside the fast range: libm's pair.
+        for x in [0.0_f32, 1.0, -90.0, f32::NEG_INFINITY] {
+            let (e, c) = exp_and_complement(x);
+            assert_eq!(e.to_bits(), libm::expf(x).to_bits(), "{x}");
+            assert_eq!(c.to_bits(), (-libm::expm1f(x)).to_bits(), "{x}");
+        }
     }
 
     #[test]

@@ -43,6 +43,35 @@ impl<T: Real> Gains<T> {
     }
 }
 
+/// The Eq. 29 blend at one instant: E = e^{−cτ} and 1 − E, each to its own relative
+/// precision. Right after the blend (re)starts E ≈ 1, and 1 − E computed from a rounded E
+/// would keep only a few significant bits (at τ = 1 s, c = 5·10⁻⁴ s⁻¹, a relative error of
+/// 6·10⁻⁵ in f32), which the law multiplies by its large Eq. 27 value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Blend<T> {
+    /// E = e^{−cτ}, in [0, 1].
+    pub weight: T,
+    /// 1 − E, in [0, 1].
+    pub complement: T,
+}
+
+impl<T: Real> Blend<T> {
+    /// The blend τ after its start for the decay rate c: `neg_c_tau` = −cτ ≤ 0.
+    #[inline(always)]
+    pub fn decayed(neg_c_tau: T) -> Self {
+        let (weight, complement) = neg_c_tau.exp_and_complement();
+        Self { weight, complement }
+    }
+
+    /// A blend of weight E given as a number (its complement computed as 1 − E).
+    pub fn from_weight(weight: T) -> Self {
+        Self {
+            weight,
+            complement: T::ONE - weight,
+        }
+    }
+}
+
 /// Everything the law needs at one instant.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LawInput<T> {
@@ -66,8 +95,8 @@ pub struct LawInput<T> {
     pub mu3: T,
     /// μ̇3 per unit reel rate, i.e. dμ3/dl, 1/m (so that μ̇3 = dμ3/dl · l̇).
     pub mu3_per_m: T,
-    /// E = e^{−cτ}, the Eq. 29 blend weight, in [0, 1].
-    pub blend_weight: T,
+    /// The Eq. 29 blend: E = e^{−cτ} and 1 − E.
+    pub blend: Blend<T>,
     /// c, the Eq. 29 decay rate, 1/s.
     pub decay_rate_per_s: T,
     /// l̇0, the rate the current stage's blend started from, m/s.
@@ -126,7 +155,7 @@ pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
     let three_halves = T::from_f64(1.5);
     let n = x.orbit_rate_radps;
     let p = x.ref_slope_rad_per_m;
-    let e = x.blend_weight;
+    let (e, one_minus_e) = (x.blend.weight, x.blend.complement);
     let k1 = x.gains.k1_per_s;
     let l_prime = x.length_m / (two + x.mu3);
     let delta = x.alpha_rad - x.ref_angle_rad;
@@ -136,8 +165,8 @@ pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
     let w = n + x.alpha_rate_radps - x.ref_time_rate_radps;
     let g0 =
         k1 * (x.alpha_rate_radps - x.ref_time_rate_radps) + x.gains.k2_per_s2 * delta - gravity;
-    let b = w + p * (e * x.initial_rate_mps + (T::ONE - e) * l_prime * k1);
-    let c = e * x.initial_rate_mps * w + (T::ONE - e) * l_prime * g0;
+    let b = w + p * (e * x.initial_rate_mps + one_minus_e * l_prime * k1);
+    let c = e * x.initial_rate_mps * w + one_minus_e * l_prime * g0;
     // One test for both: the sum of two finite values of this size is finite, and a NaN or an
     // infinity in either makes it NaN or infinite.
     if !(b + c).is_finite() {
@@ -185,7 +214,7 @@ pub fn acceleration<T: Real>(x: &LawInput<T>, s: &LawOutput<T>) -> Result<T, Law
     let two = T::from_f64(2.0);
     let three = T::from_f64(3.0);
     let n = x.orbit_rate_radps;
-    let e = x.blend_weight;
+    let (e, one_minus_e) = (x.blend.weight, x.blend.complement);
     let y = s.rate_mps;
     let u = s.law_rate_mps;
     let l = x.length_m;
@@ -198,13 +227,13 @@ pub fn acceleration<T: Real>(x: &LawInput<T>, s: &LawOutput<T>) -> Result<T, Law
         -(n + x.alpha_rate_radps) * two_mu3 * y / l - T::from_f64(1.5) * n * n * s.sin_two_alpha;
     // u̇ = (L′/D)[(k1 − N/D) δ̈ + k2 δ̇ − 3n² α̇ cos2α] + u (y/l − μ̇3/(2+μ3)),  N/D = u/L′.
     let k_eff = x.gains.k1_per_s - u / l_prime;
-    let b_coef = (T::ONE - e) * l_prime / d * k_eff;
+    let b_coef = one_minus_e * l_prime / d * k_eff;
     let rest = l_prime / d
         * (x.gains.k2_per_s2 * s.delta_rate_radps
             - three * n * n * x.alpha_rate_radps * s.cos_two_alpha)
         + u * (y / l - mu3_dot / two_mu3);
     let a = x.decay_rate_per_s * e * (u - x.initial_rate_mps)
-        + (T::ONE - e) * rest
+        + one_minus_e * rest
         + b_coef * (alpha_accel - x.ref_curvature_rad_per_m2 * y * y);
     let fold = T::ONE + b_coef * x.ref_slope_rad_per_m;
     if fold.abs() < T::from_f64(1e-3) {
@@ -236,7 +265,7 @@ mod tests {
             ref_time_rate_radps: 0.0,
             mu3: 0.0,
             mu3_per_m: 0.0,
-            blend_weight: 0.2,
+            blend: Blend::from_weight(0.2),
             decay_rate_per_s: 1e-3,
             initial_rate_mps: 0.1,
             gains: Gains::paper(),
@@ -260,7 +289,7 @@ mod tests {
         let s = solve(&x).unwrap();
         // Substituting y back: δ̇ = α̇ − (p y + r), then Eq. 29 must return y.
         let dd = x.alpha_rate_radps - (x.ref_slope_rad_per_m * s.rate_mps + x.ref_time_rate_radps);
-        let blended = eq27(&x, dd) + (x.initial_rate_mps - eq27(&x, dd)) * x.blend_weight;
+        let blended = eq27(&x, dd) + (x.initial_rate_mps - eq27(&x, dd)) * x.blend.weight;
         assert!((blended - s.rate_mps).abs() < 1e-12 * s.rate_mps.abs().max(1.0));
         assert!((s.law_rate_mps - eq27(&x, dd)).abs() < 1e-12);
     }
@@ -274,14 +303,14 @@ mod tests {
         let s = solve(&x).unwrap();
         let dd = x.alpha_rate_radps;
         let u = eq27(&x, dd);
-        let expect = u + (x.initial_rate_mps - u) * x.blend_weight;
+        let expect = u + (x.initial_rate_mps - u) * x.blend.weight;
         assert!((s.rate_mps - expect).abs() < 1e-14);
     }
 
     #[test]
     fn at_stage_start_the_command_is_the_initial_rate() {
         let x = LawInput {
-            blend_weight: 1.0,
+            blend: Blend::from_weight(1.0),
             ..base()
         };
         let s = solve(&x).unwrap();
@@ -298,7 +327,7 @@ mod tests {
             ref_angle_rad: -core::f64::consts::FRAC_PI_4,
             ref_slope_rad_per_m: 0.0,
             ref_curvature_rad_per_m2: 0.0,
-            blend_weight: 0.0,
+            blend: Blend::from_weight(0.0),
             ..base()
         };
         let s = solve(&x).unwrap();
@@ -317,7 +346,7 @@ mod tests {
         // With E = 0, substituting l̇ from Eq. 27 into Eq. 26 gives
         // δ̈ + k1 δ̇ + k2 δ = −α̈_r − (2+μ3) α̇_r l̇/l  (Eq. 28).
         let x = LawInput {
-            blend_weight: 0.0,
+            blend: Blend::from_weight(0.0),
             mu3: 0.07,
             ref_time_rate_radps: 2e-5,
             ..base()
@@ -360,7 +389,7 @@ mod tests {
                     + 0.5 * x0.ref_curvature_rad_per_m2 * dl * dl,
                 ref_slope_rad_per_m: x0.ref_slope_rad_per_m + x0.ref_curvature_rad_per_m2 * dl,
                 mu3: x0.mu3 + x0.mu3_per_m * dl,
-                blend_weight: x0.blend_weight * (-x0.decay_rate_per_s * h).exp(),
+                blend: Blend::from_weight(x0.blend.weight * (-x0.decay_rate_per_s * h).exp()),
                 ..x0
             };
             solve(&x).unwrap().rate_mps

@@ -38,6 +38,9 @@ pub trait Real:
     fn cos(self) -> Self;
     /// `e^x`.
     fn exp(self) -> Self;
+    /// (e^x, 1 − e^x), the second to its own relative precision (not 1 minus the first: no
+    /// cancellation where e^x ≈ 1).
+    fn exp_and_complement(self) -> (Self, Self);
     /// Square root (NaN for negative input).
     fn sqrt(self) -> Self;
     /// `(sin x, cos x)`, sharing the argument reduction where the implementation can.
@@ -142,6 +145,10 @@ impl Real for f32 {
         crate::fastmath::exp(self)
     }
     #[inline]
+    fn exp_and_complement(self) -> (Self, Self) {
+        crate::fastmath::exp_and_complement(self)
+    }
+    #[inline]
     fn sqrt(self) -> Self {
         crate::fastmath::sqrt(self)
     }
@@ -197,6 +204,10 @@ impl Real for f64 {
     #[inline]
     fn exp(self) -> Self {
         libm::exp(self)
+    }
+    #[inline]
+    fn exp_and_complement(self) -> (Self, Self) {
+        (libm::exp(self), -libm::expm1(self))
     }
     #[inline]
     fn sqrt(self) -> Self {

@@ -41,6 +41,11 @@ const RATE_FLOOR_MPS: f64 = 1e-3;
 /// The accuracy goal of issue 7: f32 within 1e-5 of f64 (relative, as defined above).
 const GOAL: f64 = 1e-5;
 
+/// An error above the goal counts as explained by the inputs' precision when it is within this
+/// factor of the input-rounding effect: half an f32 spacing of α alone moves the f64 command
+/// that much, and the f32 evaluation rounds α_r, δ and a few more quantities of the same size.
+const UNEXPLAINED_FACTOR: f64 = 4.0;
+
 /// The relative difference e of one step (see the crate docs).
 fn rel_diff(y32: f32, y64: f64) -> f64 {
     (f64::from(y32) - y64).abs() / y64.abs().max(RATE_FLOOR_MPS)
@@ -89,6 +94,9 @@ struct Figures {
     state_mismatches: u32,
     /// Largest |α_r32 − α_r64| (the reference schedule in f32 against f64), rad.
     max_ref_angle_diff_rad: f64,
+    /// Steps above the goal and above [`UNEXPLAINED_FACTOR`] × the input-rounding effect: an
+    /// f32 error not explained by the law's conditioning at the inputs' precision.
+    unexplained: u32,
 }
 
 impl Figures {
@@ -112,7 +120,8 @@ impl Figures {
              input rounding there {:.2e}), p99.9 {:.2e}, p99 {:.2e}, median {:.2e}; \
              {} steps above {GOAL:e}; largest input-rounding effect {:.2e}; \
              largest |α_r32 − α_r64| {:.2e} rad (at the worst step {:.2e} rad); \
-             phase/health mismatches {}",
+             phase/health mismatches {}; above {GOAL:e} and {UNEXPLAINED_FACTOR} × the \
+             input-rounding effect: {}",
             self.steps,
             self.rels.len(),
             w.rel,
@@ -128,7 +137,8 @@ impl Figures {
             self.max_input_rounding,
             self.max_ref_angle_diff_rad,
             w.ref_angle_diff_rad,
-            self.state_mismatches
+            self.state_mismatches,
+            self.unexplained
         );
     }
 }
@@ -195,6 +205,9 @@ fn compare(ticks: u32, orbit_rate_radps: f32, sample: impl Fn(u32) -> Option<[f3
         if law_ran(&o32) && law_ran(&o64) {
             f.rels.push(e);
             f.max_ref_angle_diff_rad = f.max_ref_angle_diff_rad.max(dref);
+            if e > GOAL && e > UNEXPLAINED_FACTOR * sens {
+                f.unexplained += 1;
+            }
         }
         if e > f.worst.rel || f.steps == 1 {
             f.worst = Worst {
@@ -227,8 +240,8 @@ fn firmware_replay_f32_vs_f64() {
     );
     f.print("firmware replay (720 s)");
     assert_eq!(f.state_mismatches, 0);
-    // Deployment below 26 km: the goal holds at every step.
-    assert!(f.worst.rel <= GOAL, "{:?}", f.worst);
+    // Deployment below 26 km: the goal holds at every step (measured: max 5.3e-7).
+    assert!(f.worst.rel <= GOAL / 10.0, "{:?}", f.worst);
 }
 
 #[test]
@@ -236,15 +249,19 @@ fn whole_mission_f32_vs_f64() {
     let f = compare(mission::TICKS, mission::ORBIT_RATE_RADPS, mission::sample);
     f.print("paper mission (20 h)");
     assert_eq!(f.state_mismatches, 0);
-    // The goal holds on all but a handful of steps (measured: median 2.7e-8, max 5.8e-5, 11 of
-    // 72 001 steps above 1e-5, all in the first seconds after the stage-2 blend restart, where
-    // l̇0 is the last f32 command and the Eq. 27 value it blends toward is large). The quintic
-    // transitions are evaluated from the nearer band end (src/schedule.rs), which removed the
-    // f32 cancellation that used to cost 2.6e-2 at the keep phases. Bounds with margin:
-    assert!(f.worst.rel <= 2e-4, "{:?}", f.worst);
-    assert!(f.worst.abs_mps <= 1e-5, "{:?}", f.worst);
+    // The goal holds at every step except where the law itself is too ill-conditioned for
+    // any f32 evaluation: the f64 command moves by more than the goal when α moves by half
+    // an f32 spacing (measured: median 2.8e-8, max 3.6e-5, 9 of 72 001 steps above 1e-5, all
+    // at the stage-1 keep near 31.3 km where that effect reaches 5.7e-5; the command there
+    // is ≈ 1.7 mm/s and the difference 6e-8 m/s). Two earlier f32 losses are gone and stay
+    // gone: the quintic transitions are evaluated from the nearer band end (2.6e-2 at the
+    // keeps), and 1 − E of the blend is computed as −expm1(−cτ), not from the rounded E (5.8e-5
+    // right after the stage-2 restart, E ≈ 1).
+    assert_eq!(f.unexplained, 0, "{:?}", f.worst);
+    assert!(f.worst.rel <= 1e-4, "{:?}", f.worst);
+    assert!(f.worst.abs_mps <= 1e-6, "{:?}", f.worst);
     assert!(
-        f.above_goal() * 1000 <= f.rels.len(),
+        f.above_goal() * 5000 <= f.rels.len(),
         "{} of {} steps above {GOAL:e}",
         f.above_goal(),
         f.rels.len()
@@ -317,6 +334,9 @@ fn random_states_f32_vs_f64() {
         let sens = input_rounding(&before, &to_f64(&x), y64);
         f.max_input_rounding = f.max_input_rounding.max(sens);
         f.rels.push(e);
+        if e > GOAL && e > UNEXPLAINED_FACTOR * sens {
+            f.unexplained += 1;
+        }
         let dref = ref_diff(&o32, &o64);
         f.max_ref_angle_diff_rad = f.max_ref_angle_diff_rad.max(dref);
         if e > f.worst.rel {

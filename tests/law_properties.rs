@@ -7,7 +7,7 @@
 //! - The physical root is the one that tends to the explicit law as p → 0 (linearly).
 
 use proptest::prelude::*;
-use tss_reel::law::{solve, Gains, LawInput};
+use tss_reel::law::{solve, Blend, Gains, LawInput};
 
 const N: f64 = 1.060_237_230_236_363_5e-3;
 
@@ -35,7 +35,7 @@ prop_compose! {
             ref_time_rate_radps: ref_time_rate,
             mu3,
             mu3_per_m: 0.0,
-            blend_weight: blend,
+            blend: Blend::from_weight(blend),
             decay_rate_per_s: 1e-3,
             initial_rate_mps: initial_rate,
             gains: Gains::paper(),
@@ -63,7 +63,7 @@ proptest! {
         if let Ok(s) = solve(&x) {
             let dd = x.alpha_rate_radps - (x.ref_slope_rad_per_m * s.rate_mps + x.ref_time_rate_radps);
             let u = eq27(&x, dd);
-            let blended = u + (x.initial_rate_mps - u) * x.blend_weight;
+            let blended = u + (x.initial_rate_mps - u) * x.blend.weight;
             let scale = s.rate_mps.abs().max(u.abs()).max(1e-3);
             prop_assert!((blended - s.rate_mps).abs() <= 1e-9 * scale, "y = {}, Eqs. 27+29 give {blended}", s.rate_mps);
             prop_assert!((s.law_rate_mps - u).abs() <= 1e-9 * scale);
@@ -72,7 +72,7 @@ proptest! {
 
     #[test]
     fn closed_loop_identity_eq28(x in state()) {
-        let x = LawInput { blend_weight: 0.0, ..x };
+        let x = LawInput { blend: Blend::from_weight(0.0), ..x };
         if let Ok(s) = solve(&x) {
             let (n, y, l) = (x.orbit_rate_radps, s.rate_mps, x.length_m);
             // Eq. 26's left side with α̈ from Eq. 5b (circular, β = 0), α̈_r taken as 0.

@@ -88,6 +88,21 @@ QEMU = ["qemu-system-arm", "-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic"
 PC = re.compile(r"Trace \d+: \S+ \[[0-9a-f]+/([0-9a-f]+)/")
 
 
+def trace_pcs(lines):
+    """(pc, line) of each executed instruction. With -icount, QEMU sometimes logs a block,
+    stops before executing it (the instruction budget ran out) and logs it again when it does:
+    a PC repeated on consecutive lines is one execution (the code has no branch-to-self)."""
+    prev = None
+    for line in lines:
+        m = PC.match(line)
+        if not m:
+            continue
+        pc = int(m.group(1), 16)
+        if pc != prev:
+            yield pc, line
+        prev = pc
+
+
 def mission_step_pcs(elf, n):
     """The PCs of the n-th call of Controller::advance (n counts from 0), read from a pipe:
     from its entry to the return to the caller (the instruction after the caller's `bl`)."""
@@ -106,11 +121,7 @@ def mission_step_pcs(elf, n):
         pcs, calls, prev, ret = [], -1, None, None
         try:
             with open(fifo) as f:
-                for line in f:
-                    m = PC.match(line)
-                    if not m:
-                        continue
-                    pc = int(m.group(1), 16)
+                for pc, _ in trace_pcs(f):
                     if pc == entry:
                         calls += 1
                         if calls == n:
@@ -137,10 +148,7 @@ def firmware_tick_pcs(elf, tick):
                        timeout=600)
         pcs, ticks, prev = [], -1, None
         with open(log) as f:
-            for line in f:
-                m = PC.match(line)
-                if not m:
-                    continue
+            for pc, line in trace_pcs(f):
                 name = line.rsplit("]", 1)[1].strip()
                 if name == "SysTick" and prev != "SysTick":
                     ticks += 1
@@ -148,7 +156,7 @@ def firmware_tick_pcs(elf, tick):
                         break
                 prev = name
                 if ticks == tick:
-                    pcs.append(int(m.group(1), 16))
+                    pcs.append(pc)
     if not pcs:
         sys.exit(f"trace_profile: tick {tick} not reached")
     return pcs
