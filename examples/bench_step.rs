@@ -378,7 +378,9 @@ mod bench {
             ref_time_rate_radps: reference.time_rate_radps,
             mu3: masses.mu3_and_slope(l).0,
             mu3_per_m: masses.mu3_and_slope(l).1,
-            blend: Blend::decayed(libm::logf(out.blend_weight.max(f32::MIN_POSITIVE))),
+            blend: Blend::decayed(-libm::fabsf(libm::logf(
+                out.blend_weight.max(f32::MIN_POSITIVE),
+            ))),
             decay_rate_per_s: decay,
             initial_rate_mps: initial,
             gains: cfg.gains,
@@ -389,8 +391,9 @@ mod bench {
             Ok(s) => m.pure((law_in, *s), |(i, s)| law::acceleration(i, s)),
             Err(_) => 0,
         };
-        // The blend's argument −cτ, recovered from the reported weight.
-        let exponent = libm::logf(out.blend_weight.max(f32::MIN_POSITIVE));
+        // The blend's argument −cτ ≤ −0, recovered from the reported weight (−0 at a restart,
+        // as in the controller: −cΔt·0).
+        let exponent = -libm::fabsf(libm::logf(out.blend_weight.max(f32::MIN_POSITIVE)));
         let blend = m.pure(exponent, |&e| Blend::decayed(e));
         let mass = m.pure(l, |&l| masses.mu3_and_slope(l));
         let mu3 = law_in.mu3;
