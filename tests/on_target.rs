@@ -136,6 +136,32 @@ mod tests {
     }
 
     #[test]
+    fn blend_weight_and_complement_match_f64_on_the_fpu() {
+        // e^x and 1 − e^x of the blend (fastmath::exp_and_complement) on the decay range,
+        // against libm's f64 on the target itself, each within two ulps of its own size.
+        let ulps =
+            |got: f32, exact: f64| (got.to_bits() as i64 - (exact as f32).to_bits() as i64).abs();
+        let mut x = -87.0_f32;
+        while x < 0.0 {
+            let (e, c) = tss_reel::fastmath::exp_and_complement(x);
+            let xd = f64::from(x);
+            let (ue, uc) = (ulps(e, libm::exp(xd)), ulps(c, -libm::expm1(xd)));
+            defmt::assert!(
+                ue <= 2 && uc <= 2,
+                "x = {=f32}: {=i64} and {=i64} ulps",
+                x,
+                ue,
+                uc
+            );
+            // Dense near 0, where the complement would lose its digits to cancellation.
+            x = if x < -1.0 { x + 0.0731 } else { x * 0.9 };
+            if x > -1e-6 {
+                break;
+            }
+        }
+    }
+
+    #[test]
     fn quintic_transition_meets_its_end_conditions_in_f32() {
         let s = tss_reel::schedule::BandSchedule::<f32>::paper_stage1();
         let lo = s.eval(10_000.0 + 1e-3);
@@ -149,7 +175,7 @@ mod tests {
     #[test]
     fn implicit_law_residual_is_zero_in_f32() {
         // Substituting the command back into Eqs. 27 + 29 gives it back (SPEC §5).
-        use tss_reel::law::{solve, Gains, LawInput};
+        use tss_reel::law::{solve, Blend, Gains, LawInput};
         let x = LawInput {
             length_m: 15_000.0_f32,
             alpha_rad: -0.6,
@@ -161,7 +187,7 @@ mod tests {
             ref_time_rate_radps: 0.0,
             mu3: 0.0,
             mu3_per_m: 0.0,
-            blend_weight: 0.2,
+            blend: Blend::from_weight(0.2),
             decay_rate_per_s: 1e-3,
             initial_rate_mps: 0.1,
             gains: Gains::paper(),
@@ -176,7 +202,7 @@ mod tests {
             / (n + dd)
             * x.length_m
             / 2.0;
-        let blended = u + (x.initial_rate_mps - u) * x.blend_weight;
+        let blended = u + (x.initial_rate_mps - u) * x.blend.weight;
         defmt::assert!(
             (blended - s.rate_mps).abs() <= 1e-4 * s.rate_mps.abs(),
             "y = {=f32}, Eq. 29 gives {=f32}",
