@@ -32,8 +32,9 @@
 //! On a step where the law ran (health `Nominal`), the public pieces the controller calls are
 //! timed separately, with the step's own arguments: the reference schedule (`PreparedBand::eval`
 //! or the stage-2 `PreparedBand::eval_slewed`), the implicit law (`law::solve`) and its
-//! acceleration (`law::acceleration`), the blend weight (`fastmath::exp`, once a step), the mass
-//! model (`MassModel::mu3_and_slope`), the equilibrium-existence margin
+//! acceleration (`law::acceleration`), the blend weight and its complement
+//! (`law::Blend::decayed`, once a step), the mass model (`MassModel::mu3_and_slope`), the
+//! equilibrium-existence margin
 //! (`ExistenceMonitor::whole_orbit_margin`) and the envelope (`Envelope::limit`). What is left of the
 //! step is the sensor validation (the monitor's checks), the sequencer and health state machine,
 //! dead reckoning and filling in the output.
@@ -256,7 +257,7 @@ mod bench {
         LawSolve,
         /// `law::acceleration`: Eq. 30.
         LawAccel,
-        /// The Eq. 29 blend weight e^{−cτ}: `fastmath::exp`, once per step.
+        /// The Eq. 29 blend weight e^{−cτ} and 1 − e^{−cτ}: `law::Blend::decayed`, once per step.
         BlendExp,
         /// μ3 and dμ3/dl: `MassModel::mu3_and_slope` (one comparison for a massless tether).
         MassModel,

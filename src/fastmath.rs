@@ -14,15 +14,16 @@
 //! absolute error below 2.5e-7 — about two f32 ulps of 1. Arguments beyond [`FAST_RANGE`]
 //! (never produced by the law, whose angles are checked to |α| ≤ π) fall back to `libm`.
 //!
-//! [`sqrt`] likewise replaces libm's bit-serial `sqrtf` (≈ 78 instructions on the M4F) with a
+//! [`sqrt`] likewise replaces libm's integer `sqrtf` (≈ 75 instructions on the M4F) with a
 //! bit-pattern estimate and Newton steps, within one ulp of the correctly rounded root.
 //!
-//! [`exp`] (the Eq. 29 blend weight e^{−cτ}, once per step) is the Cephes `expf` scheme without
+//! [`exp_and_complement`] (the Eq. 29 blend weight E = e^{−cτ} and 1 − E, once per step; [`exp`]
+//! is its first half) is the Cephes `expf` scheme without
 //! libm's general-purpose special-casing: k = round(x/ln 2), r = x − k·ln 2 in two parts, a
 //! degree-7 polynomial for e^r on |r| ≤ ln 2 / 2, and 2^k put into the exponent bits, on the
 //! decay range −87 ≤ x ≤ −0 that the blend uses. Within two ulps of the correctly rounded e^x
-//! there (proven by this module's tests on every 32nd f32 of that range); elsewhere, libm's
-//! answer.
+//! there, and so is 1 − e^x, to its own size (proven by this module's tests on every 32nd f32
+//! of that range); elsewhere, libm's answer.
 //!
 //! Rounding to an integer uses the classic `(v + 1.5·2²³) − 1.5·2²³`, which the FPU rounds to
 //! nearest-even exactly as `rintf` does for |v| < 2²² (LLVM keeps the pair: no fast-math).

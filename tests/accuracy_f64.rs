@@ -252,8 +252,8 @@ fn whole_mission_f32_vs_f64() {
     // The goal holds at every step except where the law itself is too ill-conditioned for
     // any f32 evaluation: the f64 command moves by more than the goal when α moves by half
     // an f32 spacing (measured: median 2.8e-8, max 3.6e-5, 9 of 72 001 steps above 1e-5, all
-    // at the stage-1 keep near 31.3 km where that effect reaches 5.7e-5; the command there
-    // is ≈ 1.7 mm/s and the difference 6e-8 m/s). Two earlier f32 losses are gone and stay
+    // in the stage-1 keep, at the turning points of its first swing (31.3 km and 29.6 km, the
+    // command a few mm/s) where that effect reaches 5.7e-5; the largest difference 6e-8 m/s). Two earlier f32 losses are gone and stay
     // gone: the quintic transitions are evaluated from the nearer band end (2.6e-2 at the
     // keeps), and 1 − E of the blend is computed as −expm1(−cτ), not from the rounded E (5.8e-5
     // right after the stage-2 restart, E ≈ 1).

@@ -17,7 +17,7 @@ with everything LLVM inlined into `Controller::step` sorted back into the paper'
 examples/trace_step.rs (one `Controller::step` a tick, built with the flight profile:
 `cargo build --profile firmware --target thumbv7em-none-eabihf --example trace_step`), and the
 instructions counted are those from the N-th entry into `Controller::advance` to the return to
-the caller. The trace is streamed through a pipe, not stored (a late tick is ~10^8 lines).
+the caller. The trace is streamed through a pipe, not stored (a late step is some 4·10^7 lines in).
 
 Defaults: the flight firmware (target/thumbv7em-none-eabihf/firmware/tss-reel, build it with
 `cargo fw-build`), tick 301 (a nominal deploy step that logs nothing). Needs qemu-system-arm
