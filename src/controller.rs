@@ -272,7 +272,7 @@ const MODERATE_NORMALISED_RATE: f64 = 1e5;
 
 /// The reel controller (see the module docs for a complete example).
 #[derive(Clone, Debug)]
-pub struct Controller<T> {
+pub struct Controller<T: Real> {
     cfg: Config<T>,
     stage2: bool,
     /// The first tick at which stage 2 begins: the configured start, 0 once stage 2 is
@@ -281,6 +281,10 @@ pub struct Controller<T> {
     stage_start_tick: u32,
     blend_start_tick: u32,
     blend_initial_rate_mps: T,
+    /// The current stage's blend: log₂E per tick and c (copied from [`Derived`] at each
+    /// restart, so a step reads them without selecting the stage).
+    blend_log2_per_tick: T,
+    blend_decay_rate_per_s: T,
     phase: Phase,
     health: Health,
     /// Consecutive ticks without a usable sample or law solution.
@@ -308,29 +312,37 @@ pub struct Controller<T> {
 struct Derived<T> {
     /// The longest plausible length: the spool end plus [`SPOOL_MARGIN`], m.
     spool_m: T,
-    /// The Eq. 34 schedule, its quintic's coefficients computed.
-    stage1: PreparedBand<T>,
-    /// The Eq. 35 schedule, its quintic's coefficients computed.
-    stage2: PreparedBand<T>,
-    /// −c·Δt of the stage-1 and stage-2 blends: E = e^{−cΔt·k} k ticks after a (re)start.
-    neg_decay_per_tick: [T; 2],
+    /// The Eq. 34 (stage 1) and Eq. 35 (stage 2) schedules, their quintics' coefficients
+    /// computed.
+    bands: [PreparedBand<T>; 2],
+    /// log₂E per tick of the stage-1 and stage-2 blends, −cΔt·log₂e: E = e^{−cΔt·k} =
+    /// 2^{−cΔt·log₂e·k} k ticks after a (re)start.
+    log2_decay_per_tick: [T; 2],
     /// c of the stage-1 and stage-2 blends, 1/s (Eq. 29; the Eq. 30 acceleration needs it).
     decay_rate_per_s: [T; 2],
+    /// ρ = 0: μ3 and its slope are 0 at every length (the paper's massless tether).
+    massless_tether: bool,
+    /// Deploy becomes Keep1 at this length: the stage-1 keep length less the capture, m.
+    keep1_entry_m: T,
+    /// Retrieve becomes Keep2 at this length: the stage-2 keep length plus the capture, m.
+    keep2_entry_m: T,
 }
 
 impl<T: Real> Derived<T> {
     fn new(cfg: &Config<T>) -> Self {
         let dt = cfg.period_s.to_f64();
-        let neg_decay = |c: T| T::from_f64(-c.to_f64() * dt);
+        let log2_decay = |c: T| T::from_f64(-c.to_f64() * dt * core::f64::consts::LOG2_E);
         Self {
             spool_m: T::from_f64(cfg.envelope.max_length_m.to_f64() * (1.0 + SPOOL_MARGIN)),
-            stage1: cfg.stage1.schedule.prepare(),
-            stage2: cfg.stage2.schedule.prepare(),
-            neg_decay_per_tick: [
-                neg_decay(cfg.stage1.decay_rate_per_s),
-                neg_decay(cfg.stage2.decay_rate_per_s),
+            bands: [cfg.stage1.schedule.prepare(), cfg.stage2.schedule.prepare()],
+            log2_decay_per_tick: [
+                log2_decay(cfg.stage1.decay_rate_per_s),
+                log2_decay(cfg.stage2.decay_rate_per_s),
             ],
             decay_rate_per_s: [cfg.stage1.decay_rate_per_s, cfg.stage2.decay_rate_per_s],
+            massless_tether: cfg.masses.tether_density_kg_per_m == T::ZERO,
+            keep1_entry_m: cfg.stage1.schedule.high_length_m - cfg.keep_capture_m,
+            keep2_entry_m: cfg.stage2.schedule.low_length_m + cfg.keep_capture_m,
         }
     }
 }
@@ -365,14 +377,19 @@ impl<T: Real> Controller<T> {
                 Rule::NoEquilibrium,
             )
         })?;
+        let derived = Derived::new(&cfg);
+        let monitor = Monitor::new(&cfg.monitor, derived.spool_m)?;
         Ok(Self {
             existence,
-            derived: Derived::new(&cfg),
+            derived,
+            monitor,
             stage2: false,
             stage2_due_tick: cfg.stage2.start_tick.map_or(u64::MAX, u64::from),
             stage_start_tick: 0,
             blend_start_tick: 0,
             blend_initial_rate_mps: cfg.initial_rate_mps,
+            blend_log2_per_tick: derived.log2_decay_per_tick[0],
+            blend_decay_rate_per_s: cfg.stage1.decay_rate_per_s,
             phase: Phase::Deploy,
             health: Health::Nominal,
             bad_ticks: 0,
@@ -383,7 +400,6 @@ impl<T: Real> Controller<T> {
             anchored: false,
             events: EventRing::new(),
             last_fault: None,
-            monitor: Monitor::new(),
             cfg,
         })
     }
@@ -526,10 +542,7 @@ impl<T: Real> Controller<T> {
         } else {
             None
         };
-        if let Err(s) = self
-            .monitor
-            .check(&self.cfg.monitor, x, expected, self.derived.spool_m, dt)
-        {
+        if let Err(s) = self.monitor.check(&self.cfg.monitor, x, expected, dt) {
             return self.reject(tick, predicted_m, Fault::Sensor(s), None, flags, before);
         }
         self.length_estimate_m = x.length_m;
@@ -544,7 +557,11 @@ impl<T: Real> Controller<T> {
             // Recovered: re-engage the law through the Eq. 29 blend from the current rate.
             self.restart_blend(tick, self.last_rate_cmd_mps, &mut flags);
         }
-        let (mu3, mu3_per_m) = self.cfg.masses.mu3_and_slope(x.length_m);
+        let (mu3, mu3_per_m) = if self.derived.massless_tether {
+            (T::ZERO, T::ZERO)
+        } else {
+            self.cfg.masses.mu3_and_slope(x.length_m)
+        };
         let blend = self.blend(tick);
         let law = match self.solve(x, &reference, mu3, mu3_per_m, blend) {
             Ok(v) => v,
@@ -595,25 +612,25 @@ impl<T: Real> Controller<T> {
         }
     }
 
+    /// Restarts the Eq. 29 blend of the current stage at `tick` from `rate_mps`.
     #[inline(always)]
     fn restart_blend(&mut self, tick: u32, rate_mps: T, flags: &mut Flags) {
+        let stage = usize::from(self.stage2);
         self.blend_start_tick = tick;
         self.blend_initial_rate_mps = rate_mps;
+        self.blend_log2_per_tick = self.derived.log2_decay_per_tick[stage];
+        self.blend_decay_rate_per_s = self.derived.decay_rate_per_s[stage];
         flags.set(Flags::BLEND_RESTART);
     }
 
-    /// c of the current stage's blend (Eq. 29), 1/s.
-    #[inline(always)]
-    fn decay_rate_per_s(&self) -> T {
-        self.derived.decay_rate_per_s[usize::from(self.stage2)]
-    }
-
     /// E = e^{−cτ} and 1 − E, τ = k·Δt the time since the blend (re)started k ticks ago
-    /// (Eq. 29).
+    /// (Eq. 29), as 2^{k·(−cΔt·log₂e)}.
     #[inline(always)]
     fn blend(&self, tick: u32) -> Blend<T> {
-        let k = T::from_u32(tick.saturating_sub(self.blend_start_tick));
-        Blend::decayed(self.derived.neg_decay_per_tick[usize::from(self.stage2)] * k)
+        // The blend started at this tick or before (`advance` rejects a tick that goes
+        // backwards, and `hold` reports one at the blend's start): no wrap-around.
+        let k = T::from_u32(tick.wrapping_sub(self.blend_start_tick));
+        Blend::from_log2(self.blend_log2_per_tick * k)
     }
 
     /// α_r and its derivatives at this tick and length: Eq. 34 in stage 1; in stage 2, the
@@ -623,17 +640,13 @@ impl<T: Real> Controller<T> {
     fn reference(&self, tick: u32, length_m: T) -> Reference<T> {
         if self.phase == Phase::Slew {
             let tau_s = T::from_u32(tick.saturating_sub(self.stage_start_tick)) * self.cfg.period_s;
-            return self.derived.stage2.eval_slewed(
+            return self.derived.bands[1].eval_slewed(
                 self.cfg.stage2.slew_rate_radps,
                 tau_s,
                 length_m,
             );
         }
-        let band = if self.stage2 {
-            &self.derived.stage2
-        } else {
-            &self.derived.stage1
-        };
+        let band = &self.derived.bands[usize::from(self.stage2)];
         Reference {
             angle: band.eval(length_m),
             time_rate_radps: T::ZERO,
@@ -662,7 +675,7 @@ impl<T: Real> Controller<T> {
             mu3,
             mu3_per_m,
             blend,
-            decay_rate_per_s: self.decay_rate_per_s(),
+            decay_rate_per_s: self.blend_decay_rate_per_s,
             initial_rate_mps: self.blend_initial_rate_mps,
             gains: self.cfg.gains,
         };
@@ -757,7 +770,8 @@ impl<T: Real> Controller<T> {
             rate_cmd_mps: rate,
             accel_cmd_mps2: (rate - prev) / dt,
             law_rate_mps: T::ZERO,
-            blend_weight: self.blend(tick).weight,
+            // (A tick that went backwards is reported at the blend's start.)
+            blend_weight: self.blend(tick.max(self.blend_start_tick)).weight,
             alpha_ref_rad: reference.angle.angle_rad,
             alpha_ref_rate_radps: T::ZERO,
             delta_rad: T::ZERO,
@@ -805,15 +819,10 @@ impl<T: Real> Controller<T> {
 
     #[inline(always)]
     fn update_phase(&mut self, length_m: T, slewing: bool) {
-        let capture = self.cfg.keep_capture_m;
         self.phase = match self.phase {
-            Phase::Deploy if length_m >= self.cfg.stage1.schedule.high_length_m - capture => {
-                Phase::Keep1
-            }
+            Phase::Deploy if length_m >= self.derived.keep1_entry_m => Phase::Keep1,
             Phase::Slew if !slewing => Phase::Retrieve,
-            Phase::Retrieve if length_m <= self.cfg.stage2.schedule.low_length_m + capture => {
-                Phase::Keep2
-            }
+            Phase::Retrieve if length_m <= self.derived.keep2_entry_m => Phase::Keep2,
             p => p,
         };
     }

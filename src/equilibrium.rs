@@ -487,18 +487,13 @@ impl<T: Real> ExistenceMonitor<T> {
     /// The signed whole-orbit (Eq. 13) margin of a finite normalised rate `x`:
     /// min(min Depl − x, x − max Retr), ≥ 0 exactly when an equilibrium exists over the whole
     /// orbit.
+    ///
+    /// The region is symmetric (max Retr = −min Depl exactly, see [`extent`]), so the margin is
+    /// min Depl − |x|: bit for bit the same number (min Depl − x for x ≥ 0, x + min Depl for
+    /// x < 0), without a comparison.
     #[inline(always)]
     pub fn whole_orbit_margin_of(&self, x: T) -> T {
-        let (above, below) = (
-            self.extent.min_depl.value - x,
-            x - self.extent.max_retr.value,
-        );
-        // Both finite: a plain comparison is the minimum.
-        if below < above {
-            below
-        } else {
-            above
-        }
+        self.extent.min_depl.value - x.abs()
     }
 
     /// The signed whole-orbit (Eq. 13) margin of [`check_rate`](Self::check_rate) alone:

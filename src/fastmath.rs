@@ -4,38 +4,42 @@
 //! software (about 1 200 instructions a call, SPEC §8). The law needs sin 2α and cos 2α with
 //! |2α| ≤ 2π, to a few f32 ulps. This module does it in f32 only:
 //!
-//! 1. Cody–Waite reduction: k = round(x·2/π), r = ((x − k·P1) − k·P2) − k·P3 with
-//!    P1 + P2 + P3 = π/2 split so that k·P1 and k·P2 are exact for |k| < 2¹³;
+//! 1. Cody–Waite reduction: k = round(x·2/π), r = (x − k·P1) − k·P2 with P1 + P2 = π/2 to
+//!    5·10⁻¹⁵, P1 of 21 significant bits so that k·P1 and x − k·P1 are exact for |k| ≤ 5;
 //! 2. minimax polynomials on [−π/4, π/4] (the Cephes `sinf`/`cosf` coefficients):
 //!    sin r = r + r³(s1 + r²(s2 + r² s3)), cos r = 1 − r²/2 + r⁴(c1 + r²(c2 + r² c3));
 //! 3. the quadrant k mod 4 selects ±sin r or ±cos r.
 //!
-//! Accuracy (proven by this module's tests against f64 `sin`/`cos` over |x| ≤ 8 192):
+//! Accuracy (proven by this module's tests against f64 `sin`/`cos` over |x| ≤ 8):
 //! absolute error below 2.5e-7 — about two f32 ulps of 1. Arguments beyond [`FAST_RANGE`]
-//! (never produced by the law, whose angles are checked to |α| ≤ π) fall back to `libm`.
+//! (never produced by the law: its 2α is within ±2π, α being checked to |α| ≤ π) fall back to
+//! `libm`.
 //!
 //! [`sqrt`] likewise replaces libm's integer `sqrtf` (≈ 75 instructions on the M4F) with a
 //! bit-pattern estimate and Newton steps, within one ulp of the correctly rounded root.
 //!
-//! [`exp_and_complement`] (the Eq. 29 blend weight E = e^{−cτ} and 1 − E, once per step; [`exp`]
-//! is its first half) is the Cephes `expf` scheme without
-//! libm's general-purpose special-casing: k = round(x/ln 2), r = x − k·ln 2 in two parts, a
-//! degree-7 polynomial for e^r on |r| ≤ ln 2 / 2, and 2^k put into the exponent bits, on the
-//! decay range −87 ≤ x ≤ −0 that the blend uses. Within two ulps of the correctly rounded e^x
-//! there, and so is 1 − e^x, to its own size (proven by this module's tests on every 32nd f32
-//! of that range); elsewhere, libm's answer.
+//! [`exp_and_complement`] (e^x and 1 − e^x; [`exp`] is its first half) is the Cephes `expf`
+//! scheme without libm's general-purpose special-casing: k = round(x/ln 2), r = x − k·ln 2 in
+//! two parts, a degree-7 polynomial for e^r on |r| ≤ ln 2 / 2, and 2^k put into the exponent
+//! bits, on the decay range −87 ≤ x ≤ −0. Within two ulps of the correctly rounded e^x there,
+//! and so is 1 − e^x, to its own size (proven by this module's tests on every 32nd f32 of that
+//! range); elsewhere, libm's answer. [`exp2_and_complement`] is the same for 2^t on
+//! −126 ≤ t ≤ −0, where the reduction is exact (r = (t − round t)·ln 2): the Eq. 29 blend
+//! weight E = e^{−cτ} = 2^{(−cΔt·log₂e)·k} and 1 − E, once per step, with −cΔt·log₂e prepared
+//! once per stage.
 //!
 //! Rounding to an integer uses the classic `(v + 1.5·2²³) − 1.5·2²³`, which the FPU rounds to
 //! nearest-even exactly as `rintf` does for |v| < 2²² (LLVM keeps the pair: no fast-math).
 
-/// Largest |x| handled by the fast path; beyond it `libm` is used.
-pub const FAST_RANGE: f32 = 8192.0;
+/// Largest |x| handled by the fast path (it covers the law's |2α| ≤ 2π); beyond it `libm` is
+/// used.
+pub const FAST_RANGE: f32 = 8.0;
 
 const TWO_OVER_PI: f32 = core::f32::consts::FRAC_2_PI;
-// π/2 = P1 + P2 + P3 (P1: 8 significant bits, P2: 12, P3: the rest).
-const P1: f32 = 1.5703125;
-const P2: f32 = 0.0004837513;
-const P3: f32 = 7.54979e-08;
+// π/2 = P1 + P2 + 5.3e-15: P1 = round(π/2·2²⁰)/2²⁰ (21 significant bits, so k·P1 is exact for
+// |k| ≤ 5 = round(8·2/π)), P2 = π/2 − P1 rounded to f32.
+const P1: f32 = 1_647_099.0 / 1_048_576.0;
+const P2: f32 = 3.139_164_7e-7;
 // Cephes sinf/cosf minimax coefficients on [−π/4, π/4].
 const S1: f32 = -0.16666655;
 const S2: f32 = 0.008332161;
@@ -62,13 +66,14 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
     if !(x.abs() <= FAST_RANGE) {
         return (libm::sinf(x), libm::cosf(x));
     }
-    // |x·2/π| ≤ 5 216 < 2²².
+    // |x·2/π| ≤ 5.1 < 2²².
     let k = round_small(x * TWO_OVER_PI);
-    let r = ((x - k * P1) - k * P2) - k * P3;
+    // x − k·P1 is exact (k·P1 is, and x lies within a factor 1 ± 1/(2|k|) of it).
+    let r = (x - k * P1) - k * P2;
     let z = r * r;
     let s = r + r * z * (S1 + z * (S2 + z * S3));
     let c = 1.0 - 0.5 * z + z * z * (C1 + z * (C2 + z * C3));
-    // |k| ≤ 8192·2/π < 2¹³: the conversion is exact.
+    // |k| ≤ 5: the conversion is exact.
     match (k as i32) & 3 {
         0 => (s, c),
         1 => (c, -s),
@@ -121,7 +126,11 @@ fn sqrt_special(x: f32) -> f32 {
 /// Smallest argument of the fast [`exp`]: e^x stays a normal f32 above it.
 pub const EXP_FAST_MIN: f32 = -87.0;
 
+/// Smallest argument of the fast [`exp2_and_complement`]: 2^t stays a normal f32 above it.
+pub const EXP2_FAST_MIN: f32 = -126.0;
+
 const LOG2_E: f32 = core::f32::consts::LOG2_E;
+const LN_2: f32 = core::f32::consts::LN_2;
 // ln 2 = L1 + L2 (Cephes: L1 = 0.693359375 has 9 significant bits, so k·L1 is exact).
 const L1: f32 = 0.693_359_4;
 const L2: f32 = -2.121_944_4e-4;
@@ -159,6 +168,34 @@ pub fn exp_and_complement(x: f32) -> (f32, f32) {
     // −126 < x/ln 2 ≤ 0: k is exact and −126 ≤ k ≤ 0, so 2^k is a normal f32.
     let k = round_small(x * LOG2_E);
     let r = (x - k * L1) - k * L2;
+    two_to_k_times_exp(k, r)
+}
+
+/// (2^t, 1 − 2^t) in single precision, each within a few ulps of its own correctly rounded
+/// value: [`exp_and_complement`] for an argument already in units of ln 2 (e^x = 2^t with
+/// t = x·log₂e). A caller whose argument is a product with a constant — the Eq. 29 blend's
+/// −cτ·log₂e = (−cΔt·log₂e)·k after k ticks — folds log₂e into the constant once, and the
+/// reduction needs no two-part ln 2: the fraction t − round(t) is exact.
+///
+/// The fast path is [`EXP2_FAST_MIN`] ≤ t ≤ −0 (one unsigned comparison of the bit pattern);
+/// everything else is libm's.
+#[inline]
+pub fn exp2_and_complement(t: f32) -> (f32, f32) {
+    const NEG_ZERO: u32 = 0x8000_0000;
+    const SPAN: u32 = EXP2_FAST_MIN.to_bits() - NEG_ZERO;
+    if t.to_bits().wrapping_sub(NEG_ZERO) > SPAN {
+        return (libm::exp2f(t), -libm::expm1f(t * LN_2));
+    }
+    // −126 ≤ k ≤ 0; t − k is exact (|t − k| ≤ ½, and t and k are multiples of t's ulp).
+    let k = round_small(t);
+    let r = (t - k) * LN_2;
+    two_to_k_times_exp(k, r)
+}
+
+/// (2^k e^r, 1 − 2^k e^r) for an integer −126 ≤ k ≤ 0 and |r| ≤ ln 2 / 2 (plus rounding): the
+/// shared end of [`exp_and_complement`] and [`exp2_and_complement`].
+#[inline(always)]
+fn two_to_k_times_exp(k: f32, r: f32) -> (f32, f32) {
     // q = e^r − 1, |q| < 0.42.
     let q = r + r * r * (E0 + r * (E1 + r * (E2 + r * (E3 + r * (E4 + r * E5)))));
     let two_to_k = f32::from_bits(((k as i32).wrapping_add(127) as u32) << 23);
@@ -318,6 +355,58 @@ mod tests {
     }
 
     #[test]
+    fn exp2_and_its_complement_are_within_two_ulps_over_the_fast_range() {
+        // Every 32nd f32 in [−126, −0] (≈ 34 million arguments): 2^t and 1 − 2^t against the
+        // f64 values, each in ulps of its own size.
+        let (mut worst_e, mut worst_c) = ((0, 0.0_f32), (0, 0.0_f32));
+        for bits in (0x8000_0000..=EXP2_FAST_MIN.to_bits()).step_by(32) {
+            let t = f32::from_bits(bits);
+            let (e, c) = exp2_and_complement(t);
+            let td = f64::from(t);
+            let ue = ulps(e, libm::exp2(td));
+            let uc = ulps(c, -libm::expm1(td * core::f64::consts::LN_2));
+            if ue > worst_e.0 {
+                worst_e = (ue, t);
+            }
+            if uc > worst_c.0 {
+                worst_c = (uc, t);
+            }
+        }
+        assert!(
+            worst_e.0 <= 2,
+            "2^t: {} ulps at t = {:e}",
+            worst_e.0,
+            worst_e.1
+        );
+        assert!(
+            worst_c.0 <= 2,
+            "1 − 2^t: {} ulps at t = {:e}",
+            worst_c.0,
+            worst_c.1
+        );
+        // Both ends of the fast range, and the integers (exact powers of two).
+        assert_eq!(exp2_and_complement(-0.0), (1.0, 0.0));
+        for k in 0..=126 {
+            let t = -(k as f32);
+            assert_eq!(exp2_and_complement(t).0, libm::exp2f(t), "{t}");
+        }
+        // Outside: libm's.
+        for t in [
+            0.0_f32,
+            0.5,
+            -126.000_01,
+            -150.0,
+            f32::NEG_INFINITY,
+            f32::INFINITY,
+        ] {
+            let (e, c) = exp2_and_complement(t);
+            assert_eq!(e.to_bits(), libm::exp2f(t).to_bits(), "{t}");
+            assert_eq!(c.to_bits(), (-libm::expm1f(t * LN_2)).to_bits(), "{t}");
+        }
+        assert!(exp2_and_complement(f32::NAN).0.is_nan());
+    }
+
+    #[test]
     fn exp_special_values_are_libms() {
         assert_eq!(exp(0.0), 1.0);
         assert_eq!(exp(-0.0), 1.0);
@@ -366,6 +455,24 @@ mod tests {
             -4_194_303.5,
         ] {
             assert_eq!(round_small(v), libm::rintf(v), "{v}");
+        }
+    }
+
+    #[test]
+    fn reduction_constants_are_as_documented() {
+        let half_pi = core::f64::consts::FRAC_PI_2;
+        assert_eq!(
+            f64::from(P1),
+            libm::round(half_pi * 1_048_576.0) / 1_048_576.0
+        );
+        assert_eq!(P2, (half_pi - f64::from(P1)) as f32);
+        assert!((half_pi - f64::from(P1) - f64::from(P2)).abs() < 6e-15);
+        // k·P1 exact for every k of the fast range.
+        let k_max = libm::rintf(FAST_RANGE * TWO_OVER_PI);
+        assert_eq!(k_max, 5.0);
+        for k in 1..=5 {
+            let k = k as f32;
+            assert_eq!(f64::from(k * P1), f64::from(k) * f64::from(P1));
         }
     }
 

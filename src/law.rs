@@ -63,6 +63,15 @@ impl<T: Real> Blend<T> {
         Self { weight, complement }
     }
 
+    /// The blend whose weight is E = 2^`log2_weight`: τ after its start for the decay rate c,
+    /// `log2_weight` = −cτ·log₂e ≤ 0 (the same E as [`Blend::decayed`], with log₂e folded into
+    /// the caller's constant −cΔt·log₂e; see [`crate::fastmath::exp2_and_complement`]).
+    #[inline(always)]
+    pub fn from_log2(log2_weight: T) -> Self {
+        let (weight, complement) = log2_weight.exp2_and_complement();
+        Self { weight, complement }
+    }
+
     /// A blend of weight E given as a number (its complement computed as 1 − E).
     pub fn from_weight(weight: T) -> Self {
         Self {

@@ -5,9 +5,9 @@
 //! A rejected sample never reaches the law; the controller takes its documented safe action
 //! (see [`crate::controller`]).
 
-use crate::config::{positive, ConfigError};
+use crate::config::{positive, ConfigError, Rule};
 use crate::controller::Input;
-use crate::real::Real;
+use crate::real::{PositiveInterval, Real};
 
 /// Which sensed value was rejected, and why.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -111,45 +111,68 @@ struct Accepted<T> {
     alpha_rate_radps: T,
 }
 
-/// State of the sensor checks.
+/// State of the sensor checks, and their range limits prepared once.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Monitor<T> {
+pub(crate) struct Monitor<T: Real> {
+    /// [`MIN_PLAUSIBLE_LENGTH_M`, spool end + [`SPOOL_MARGIN`]].
+    length_m: PositiveInterval<T>,
+    /// [min, max] orbit rate.
+    orbit_rate_radps: PositiveInterval<T>,
     last: Option<Accepted<T>>,
     /// Bits of the last α reading and how often it repeated.
-    same_alpha_bits: u64,
+    same_alpha_bits: T::Bits,
     same_count: u32,
     implied_motion_rad: T,
 }
 
 impl<T: Real> Monitor<T> {
-    pub(crate) fn new() -> Self {
-        Self {
+    /// A monitor for a validated configuration: `spool_m` is the longest plausible length (the
+    /// spool end plus [`SPOOL_MARGIN`]). Fails if that is not finite or below
+    /// [`MIN_PLAUSIBLE_LENGTH_M`] (no length could ever be accepted).
+    pub(crate) fn new(cfg: &MonitorConfig<T>, spool_m: T) -> Result<Self, ConfigError> {
+        let length_m = PositiveInterval::new(T::from_f64(MIN_PLAUSIBLE_LENGTH_M), spool_m)
+            .ok_or_else(|| {
+                let rule = if spool_m.is_finite() {
+                    Rule::BandInverted
+                } else {
+                    Rule::NotFinite
+                };
+                ConfigError::new("envelope.max_length_m", spool_m, rule)
+            })?;
+        let orbit_rate_radps =
+            PositiveInterval::new(cfg.min_orbit_rate_radps, cfg.max_orbit_rate_radps).ok_or(
+                ConfigError::new(
+                    "monitor.max_orbit_rate_radps",
+                    cfg.max_orbit_rate_radps,
+                    Rule::BandInverted,
+                ),
+            )?;
+        Ok(Self {
+            length_m,
+            orbit_rate_radps,
             last: None,
-            same_alpha_bits: 0,
+            same_alpha_bits: T::ZERO.bits(),
             same_count: 0,
             implied_motion_rad: T::ZERO,
-        }
+        })
     }
 
     /// Checks one sample. `expected_length_m` is the length the controller predicts for this
-    /// tick (`None` when it has no trustworthy prediction); `spool_m` is the longest plausible
-    /// length (the spool end plus [`SPOOL_MARGIN`]).
+    /// tick (`None` when it has no trustworthy prediction).
     ///
-    /// Each range check is one comparison chain that NaN fails (every comparison with NaN is
-    /// false) and that ±∞ fails (the bounds are finite), so "finite and in range" costs no
-    /// separate finiteness test.
+    /// Each range check is one comparison that NaN and ±∞ fail (see [`PositiveInterval`]; for
+    /// the angles, every comparison with NaN is false and the bounds are finite), so "finite
+    /// and in range" costs no separate finiteness test.
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(range)` is meant: it is true for NaN.
     pub(crate) fn check(
         &mut self,
         cfg: &MonitorConfig<T>,
         x: &Input<T>,
         expected_length_m: Option<T>,
-        spool_m: T,
         period_s: T,
     ) -> Result<(), Sensor> {
         let pi = T::from_f64(core::f64::consts::PI);
-        let shortest = T::from_f64(MIN_PLAUSIBLE_LENGTH_M);
-        if !(x.length_m >= shortest && x.length_m <= spool_m) {
+        if !self.length_m.contains(x.length_m) {
             return Err(Sensor::Length);
         }
         if !(x.alpha_rad.abs() <= pi) {
@@ -158,9 +181,7 @@ impl<T: Real> Monitor<T> {
         if !(x.alpha_rate_radps.abs() <= cfg.max_alpha_rate_radps) {
             return Err(Sensor::AlphaRate);
         }
-        if !(x.orbit_rate_radps >= cfg.min_orbit_rate_radps
-            && x.orbit_rate_radps <= cfg.max_orbit_rate_radps)
-        {
+        if !self.orbit_rate_radps.contains(x.orbit_rate_radps) {
             return Err(Sensor::OrbitRate);
         }
         if let Some(expected) = expected_length_m {

@@ -137,10 +137,29 @@ mod tests {
 
     #[test]
     fn blend_weight_and_complement_match_f64_on_the_fpu() {
-        // e^x and 1 − e^x of the blend (fastmath::exp_and_complement) on the decay range,
+        // 2^t and 1 − 2^t of the blend (fastmath::exp2_and_complement, t = −cτ·log₂e) on its
+        // fast range, and e^x and 1 − e^x (fastmath::exp_and_complement) on the decay range,
         // against libm's f64 on the target itself, each within two ulps of its own size.
         let ulps =
             |got: f32, exact: f64| (got.to_bits() as i64 - (exact as f32).to_bits() as i64).abs();
+        let mut t = -126.0_f32;
+        while t < 0.0 {
+            let (e, c) = tss_reel::fastmath::exp2_and_complement(t);
+            let td = f64::from(t);
+            let exact_c = -libm::expm1(td * core::f64::consts::LN_2);
+            let (ue, uc) = (ulps(e, libm::exp2(td)), ulps(c, exact_c));
+            defmt::assert!(
+                ue <= 2 && uc <= 2,
+                "t = {=f32}: {=i64} and {=i64} ulps",
+                t,
+                ue,
+                uc
+            );
+            t = if t < -1.0 { t + 0.0731 } else { t * 0.9 };
+            if t > -1e-6 {
+                break;
+            }
+        }
         let mut x = -87.0_f32;
         while x < 0.0 {
             let (e, c) = tss_reel::fastmath::exp_and_complement(x);

@@ -41,7 +41,7 @@ CATEGORIES = [
     ("law::acceleration", r"law::acceleration"),
     ("envelope: libm::sqrtf", r"sqrt.*(Envelope|envelope::)"),
     ("envelope: the rest", r"Envelope|envelope::"),
-    ("blend e^(-cτ): fastmath::exp", r"expf|fastmath::exp|blend_weight"),
+    ("blend E = 2^(-cτ·log2 e) and 1 - E: fastmath::exp2_and_complement", r"expf|fastmath::exp|blend_weight|Blend"),
     ("mass model (coefficients, mu3_rate)", r"MassModel"),
     ("existence check (Eq. 13 margin)", r"equilibrium::|equilibrium_margin"),
     ("sensor validation (Monitor::check)", r"Monitor.*::check"),
