@@ -557,11 +557,7 @@ impl<T: Real> Controller<T> {
             // Recovered: re-engage the law through the Eq. 29 blend from the current rate.
             self.restart_blend(tick, self.last_rate_cmd_mps, &mut flags);
         }
-        let (mu3, mu3_per_m) = if self.derived.massless_tether {
-            (T::ZERO, T::ZERO)
-        } else {
-            self.cfg.masses.mu3_and_slope(x.length_m)
-        };
+        let (mu3, mu3_per_m) = self.mu3_and_slope(x.length_m);
         let blend = self.blend(tick);
         let law = match self.solve(x, &reference, mu3, mu3_per_m, blend) {
             Ok(v) => v,
@@ -609,6 +605,18 @@ impl<T: Real> Controller<T> {
             equilibrium_margin: margin,
             flags,
             fault: None,
+        }
+    }
+
+    /// (μ3, dμ3/dl) at `length_m` (Eq. 5's mass coefficient, [`crate::mass::MassModel`]):
+    /// both 0 for the massless tether, decided once in [`Controller::new`] (one flag test a
+    /// step instead of the model's float comparison).
+    #[inline(always)]
+    fn mu3_and_slope(&self, length_m: T) -> (T, T) {
+        if self.derived.massless_tether {
+            (T::ZERO, T::ZERO)
+        } else {
+            self.cfg.masses.mu3_and_slope(length_m)
         }
     }
 
@@ -760,7 +768,7 @@ impl<T: Real> Controller<T> {
             .limit_request(target, prev, self.length_estimate_m, dt);
         flags.set(sat.0 & Flags::LENGTH_LIMITED);
         self.last_rate_cmd_mps = rate;
-        let mu3 = self.cfg.masses.mu3_and_slope(self.length_estimate_m).0;
+        let mu3 = self.mu3_and_slope(self.length_estimate_m).0;
         let margin = self.equilibrium_margin(mu3, self.length_estimate_m, rate, &mut flags);
         self.note_events(tick, before, fault, flags);
         Output {
