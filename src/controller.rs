@@ -286,6 +286,11 @@ pub struct Controller<T: Real> {
     blend_log2_per_tick: T,
     blend_decay_rate_per_s: T,
     phase: Phase,
+    /// The phase ends by length when `capture_sign · l ≥ capture_m` (Deploy: l reaches the
+    /// stage-1 keep; Retrieve: l comes down to the stage-2 keep; never in the other phases:
+    /// `capture_m` = +∞). Set with the phase, one comparison a step.
+    capture_sign: T,
+    capture_m: T,
     health: Health,
     /// Consecutive ticks without a usable sample or law solution.
     bad_ticks: u32,
@@ -391,6 +396,8 @@ impl<T: Real> Controller<T> {
             blend_log2_per_tick: derived.log2_decay_per_tick[0],
             blend_decay_rate_per_s: cfg.stage1.decay_rate_per_s,
             phase: Phase::Deploy,
+            capture_sign: T::ONE,
+            capture_m: derived.keep1_entry_m,
             health: Health::Nominal,
             bad_ticks: 0,
             good_ticks: 0,
@@ -528,7 +535,7 @@ impl<T: Real> Controller<T> {
             self.stage2_due_tick = u64::MAX;
             self.stage_start_tick = tick;
             self.restart_blend(tick, self.last_rate_cmd_mps, &mut flags);
-            self.phase = Phase::Slew;
+            self.enter(Phase::Slew);
         }
 
         let Some(x) = sample else {
@@ -825,13 +832,33 @@ impl<T: Real> Controller<T> {
         }
     }
 
+    /// The phase after a step at `length_m`: Deploy becomes Keep1 at the stage-1 keep length
+    /// (less the capture), Slew becomes Retrieve once α_r meets the Eq. 35 schedule, Retrieve
+    /// becomes Keep2 at the stage-2 keep length (plus the capture).
     #[inline(always)]
     fn update_phase(&mut self, length_m: T, slewing: bool) {
-        self.phase = match self.phase {
-            Phase::Deploy if length_m >= self.derived.keep1_entry_m => Phase::Keep1,
-            Phase::Slew if !slewing => Phase::Retrieve,
-            Phase::Retrieve if length_m <= self.derived.keep2_entry_m => Phase::Keep2,
-            p => p,
+        if self.phase == Phase::Slew {
+            if !slewing {
+                self.enter(Phase::Retrieve);
+            }
+        } else if self.capture_sign * length_m >= self.capture_m {
+            match self.phase {
+                Phase::Deploy => self.enter(Phase::Keep1),
+                Phase::Retrieve => self.enter(Phase::Keep2),
+                _ => {}
+            }
+        }
+    }
+
+    /// Makes `phase` the current phase, with its length capture.
+    #[inline(always)]
+    fn enter(&mut self, phase: Phase) {
+        let never = T::from_f64(f64::INFINITY);
+        (self.capture_sign, self.capture_m) = match phase {
+            Phase::Deploy => (T::ONE, self.derived.keep1_entry_m),
+            Phase::Retrieve => (-T::ONE, -self.derived.keep2_entry_m),
+            Phase::Keep1 | Phase::Slew | Phase::Keep2 => (T::ONE, never),
         };
+        self.phase = phase;
     }
 }

@@ -148,6 +148,12 @@ pub struct LawOutput<T> {
     pub sin_two_alpha: T,
     /// cos 2α, reused by [`acceleration`].
     pub cos_two_alpha: T,
+    /// L′ = l/(2 + μ3), m, reused by [`acceleration`].
+    pub reduced_length_m: T,
+    /// 1.5 n², the gravity-gradient factor of Eq. 27, 1/s², reused by [`acceleration`].
+    pub gradient_per_s2: T,
+    /// N/D = l̇/L′, the Eq. 27 fraction, 1/s, reused by [`acceleration`].
+    pub fraction_per_s: T,
 }
 
 /// Smallest admissible value of b relative to n: below this the Eq. 27 denominator n + δ̇ is
@@ -170,7 +176,8 @@ pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
     let delta = x.alpha_rad - x.ref_angle_rad;
     // sin(2δ + 2α_r) = sin 2α.
     let (sin2a, cos2a) = (two * x.alpha_rad).sin_cos();
-    let gravity = three_halves * n * n * sin2a;
+    let gradient = three_halves * n * n;
+    let gravity = gradient * sin2a;
     let w = n + x.alpha_rate_radps - x.ref_time_rate_radps;
     let g0 =
         k1 * (x.alpha_rate_radps - x.ref_time_rate_radps) + x.gains.k2_per_s2 * delta - gravity;
@@ -196,7 +203,8 @@ pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
         return Err(LawFault::SingularDenominator);
     }
     // Eq. 27 itself, evaluated with the consistent δ̇.
-    let law_rate = (k1 * delta_rate + x.gains.k2_per_s2 * delta - gravity) / denom * l_prime;
+    let fraction = (k1 * delta_rate + x.gains.k2_per_s2 * delta - gravity) / denom;
+    let law_rate = fraction * l_prime;
     if !(y + law_rate).is_finite() {
         return Err(LawFault::NotFinite);
     }
@@ -209,6 +217,9 @@ pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
         denominator_radps: denom,
         sin_two_alpha: sin2a,
         cos_two_alpha: cos2a,
+        reduced_length_m: l_prime,
+        gradient_per_s2: gradient,
+        fraction_per_s: fraction,
     })
 }
 
@@ -221,26 +232,23 @@ pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
 /// ÿ = A / (1 + B p).
 pub fn acceleration<T: Real>(x: &LawInput<T>, s: &LawOutput<T>) -> Result<T, LawFault> {
     let two = T::from_f64(2.0);
-    let three = T::from_f64(3.0);
     let n = x.orbit_rate_radps;
     let (e, one_minus_e) = (x.blend.weight, x.blend.complement);
     let y = s.rate_mps;
     let u = s.law_rate_mps;
     let l = x.length_m;
-    let two_mu3 = two + x.mu3;
-    let l_prime = l / two_mu3;
+    let l_prime = s.reduced_length_m;
     let d = s.denominator_radps;
     let mu3_dot = x.mu3_per_m * y;
-    // Eq. 5b (circular, β = 0) with l̇ = y.
-    let alpha_accel =
-        -(n + x.alpha_rate_radps) * two_mu3 * y / l - T::from_f64(1.5) * n * n * s.sin_two_alpha;
-    // u̇ = (L′/D)[(k1 − N/D) δ̈ + k2 δ̇ − 3n² α̇ cos2α] + u (y/l − μ̇3/(2+μ3)),  N/D = u/L′.
-    let k_eff = x.gains.k1_per_s - u / l_prime;
+    // Eq. 5b (circular, β = 0) with l̇ = y: (2 + μ3) y/l = y/L′.
+    let alpha_accel = -(n + x.alpha_rate_radps) * y / l_prime - s.gradient_per_s2 * s.sin_two_alpha;
+    // u̇ = (L′/D)[(k1 − N/D) δ̈ + k2 δ̇ − 3n² α̇ cos2α] + u (y/l − μ̇3/(2+μ3)).
+    let k_eff = x.gains.k1_per_s - s.fraction_per_s;
     let b_coef = one_minus_e * l_prime / d * k_eff;
     let rest = l_prime / d
         * (x.gains.k2_per_s2 * s.delta_rate_radps
-            - three * n * n * x.alpha_rate_radps * s.cos_two_alpha)
-        + u * (y / l - mu3_dot / two_mu3);
+            - two * s.gradient_per_s2 * x.alpha_rate_radps * s.cos_two_alpha)
+        + u * (y / l - mu3_dot / (two + x.mu3));
     let a = x.decay_rate_per_s * e * (u - x.initial_rate_mps)
         + one_minus_e * rest
         + b_coef * (alpha_accel - x.ref_curvature_rad_per_m2 * y * y);

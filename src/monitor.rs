@@ -103,7 +103,8 @@ impl<T: Real> MonitorConfig<T> {
     }
 }
 
-/// The last accepted sample, for the consistency checks.
+/// The last accepted sample, for the consistency checks. Before the first one, α is NaN: a
+/// prediction from it is NaN, and every comparison with NaN is false, so no jump is seen.
 #[derive(Clone, Copy, Debug)]
 struct Accepted<T> {
     tick: u32,
@@ -118,8 +119,9 @@ pub(crate) struct Monitor<T: Real> {
     length_m: PositiveInterval<T>,
     /// [min, max] orbit rate.
     orbit_rate_radps: PositiveInterval<T>,
-    last: Option<Accepted<T>>,
-    /// Bits of the last α reading and how often it repeated.
+    last: Accepted<T>,
+    /// Bits of the last α reading and how often it repeated (NaN's bits before the first
+    /// reading: an accepted α is never NaN, so the first reading is always fresh).
     same_alpha_bits: T::Bits,
     same_count: u32,
     implied_motion_rad: T,
@@ -150,15 +152,21 @@ impl<T: Real> Monitor<T> {
         Ok(Self {
             length_m,
             orbit_rate_radps,
-            last: None,
-            same_alpha_bits: T::ZERO.bits(),
+            last: Accepted {
+                tick: 0,
+                alpha_rad: T::from_f64(f64::NAN),
+                alpha_rate_radps: T::ZERO,
+            },
+            same_alpha_bits: T::from_f64(f64::NAN).bits(),
             same_count: 0,
             implied_motion_rad: T::ZERO,
         })
     }
 
     /// Checks one sample. `expected_length_m` is the length the controller predicts for this
-    /// tick (`None` when it has no trustworthy prediction).
+    /// tick (`None` when it has no trustworthy prediction). The controller never checks a
+    /// sample whose tick is before the last accepted one (it rejects a tick that goes
+    /// backwards first).
     ///
     /// Each range check is one comparison that NaN and ±∞ fail (see [`PositiveInterval`]; for
     /// the angles, every comparison with NaN is false and the bounds are finite), so "finite
@@ -189,16 +197,17 @@ impl<T: Real> Monitor<T> {
                 return Err(Sensor::LengthJump);
             }
         }
-        if let Some(last) = self.last {
-            let ticks = T::from_u32(x.tick.saturating_sub(last.tick).max(1));
-            let predicted = last.alpha_rad + last.alpha_rate_radps * (ticks * period_s);
-            if (x.alpha_rad - predicted).abs() > cfg.alpha_jump_rad * ticks {
-                return Err(Sensor::AlphaJump);
-            }
+        // (No wrap-around: see above. Before any accepted sample `predicted` is NaN and the
+        // test is false.)
+        let last = &self.last;
+        let ticks = T::from_u32(x.tick.wrapping_sub(last.tick).max(1));
+        let predicted = last.alpha_rad + last.alpha_rate_radps * (ticks * period_s);
+        if (x.alpha_rad - predicted).abs() > cfg.alpha_jump_rad * ticks {
+            return Err(Sensor::AlphaJump);
         }
         // Stuck: the same reading again and again while α̇ says it should have moved.
         let bits = x.alpha_rad.bits();
-        if self.same_count > 0 && bits == self.same_alpha_bits {
+        if bits == self.same_alpha_bits {
             self.same_count = self.same_count.saturating_add(1);
             self.implied_motion_rad = self.implied_motion_rad + x.alpha_rate_radps.abs() * period_s;
             if self.same_count >= cfg.stuck_ticks && self.implied_motion_rad >= cfg.stuck_motion_rad
@@ -212,11 +221,11 @@ impl<T: Real> Monitor<T> {
             self.same_count = 1;
             self.implied_motion_rad = T::ZERO;
         }
-        self.last = Some(Accepted {
+        self.last = Accepted {
             tick: x.tick,
             alpha_rad: x.alpha_rad,
             alpha_rate_radps: x.alpha_rate_radps,
-        });
+        };
         Ok(())
     }
 }
