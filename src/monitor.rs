@@ -229,3 +229,60 @@ impl<T: Real> Monitor<T> {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(tick: u32, alpha_rad: f64, alpha_rate_radps: f64) -> Input<f64> {
+        Input {
+            tick,
+            length_m: 1_000.0,
+            alpha_rad,
+            alpha_rate_radps,
+            orbit_rate_radps: 1.06e-3,
+        }
+    }
+
+    #[test]
+    fn alpha_jump_is_judged_against_the_last_accepted_sample() {
+        let cfg = MonitorConfig::<f64>::default_for_period();
+        let mut m = Monitor::new(&cfg, 42_000.0).unwrap();
+        // No previous sample: any α in range is accepted (the NaN prediction sees no jump).
+        assert_eq!(m.check(&cfg, &sample(5, 3.0, 0.01), None, 1.0), Ok(()));
+        // Predicted 3.01 one tick later; 0.1 rad allowed.
+        assert_eq!(m.check(&cfg, &sample(6, 3.105, 0.0), None, 1.0), Ok(()));
+        assert_eq!(
+            m.check(&cfg, &sample(7, 2.9, 0.0), None, 1.0),
+            Err(Sensor::AlphaJump)
+        );
+        // Three ticks after the last accepted one (tick 6): 0.3 rad allowed.
+        assert_eq!(m.check(&cfg, &sample(9, 2.85, 0.0), None, 1.0), Ok(()));
+        // The same tick again: one tick's allowance, no motion predicted.
+        assert_eq!(m.check(&cfg, &sample(9, 2.93, 0.0), None, 1.0), Ok(()));
+        assert_eq!(
+            m.check(&cfg, &sample(9, 3.1, 0.0), None, 1.0),
+            Err(Sensor::AlphaJump)
+        );
+    }
+
+    #[test]
+    fn a_first_reading_of_zero_starts_a_fresh_count() {
+        let cfg = MonitorConfig::<f64> {
+            stuck_ticks: 2,
+            stuck_motion_rad: 0.015,
+            ..MonitorConfig::default_for_period()
+        };
+        let mut m = Monitor::new(&cfg, 42_000.0).unwrap();
+        // 0.0 rad is not mistaken for a repeat of anything before the first reading.
+        assert_eq!(m.check(&cfg, &sample(0, 0.0, 0.01), None, 1.0), Ok(()));
+        assert_eq!(m.same_count, 1);
+        assert_eq!(m.implied_motion_rad, 0.0);
+        // Second identical reading: 2 in a row, 0.01 rad implied (< 0.015): still accepted.
+        assert_eq!(m.check(&cfg, &sample(1, 0.0, 0.01), None, 1.0), Ok(()));
+        assert_eq!(
+            m.check(&cfg, &sample(2, 0.0, 0.01), None, 1.0),
+            Err(Sensor::AlphaStuck)
+        );
+    }
+}
