@@ -268,7 +268,8 @@ where
     })
 }
 
-fn write_file(
+/// Creates `path` and writes it through a buffer with `body`; an error names the file.
+pub(crate) fn write_file(
     path: &Path,
     body: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
 ) -> anyhow::Result<()> {

@@ -8,7 +8,7 @@
 
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::{BufReader, BufWriter, IsTerminal, Write};
+use std::io::{BufReader, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 use super::campaign::{Campaign, RunRecord};
 use super::stats::{render, CampaignInfo, Shard};
 use super::{plots, table};
-use crate::run_cmd::{check_output_dir, UsageError};
+use crate::run_cmd::{check_output_dir, write_file, UsageError};
 use crate::scenario::Scenario;
 
 /// Arguments of `tss-sim montecarlo`.
@@ -237,17 +237,6 @@ fn write_outputs(
         Ok(())
     };
     Ok((summary, figures))
-}
-
-fn write_file(
-    path: &Path,
-    body: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
-) -> anyhow::Result<()> {
-    let file = File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    let mut w = BufWriter::new(file);
-    body(&mut w)
-        .and_then(|()| w.flush())
-        .with_context(|| format!("writing {}", path.display()))
 }
 
 /// One shard directory, read and checked.
