@@ -559,7 +559,7 @@ impl<T: Real> Controller<T> {
         if self.health == Health::SafeHold {
             self.good_ticks = self.good_ticks.saturating_add(1);
             if self.good_ticks < self.cfg.monitor.recovery_ticks {
-                return self.hold(tick, &reference, flags, None, before);
+                return self.hold(tick, reference.angle.angle_rad, flags, None, before);
             }
             // Recovered: re-engage the law through the Eq. 29 blend from the current rate.
             self.restart_blend(tick, self.last_rate_cmd_mps, &mut flags);
@@ -570,7 +570,8 @@ impl<T: Real> Controller<T> {
             Ok(v) => v,
             Err(f) => {
                 let (sensed, f) = (x.length_m, Fault::Law(f));
-                return self.reject(tick, sensed, f, Some(&reference), flags, before);
+                let alpha_ref = Some(reference.angle.angle_rad);
+                return self.reject(tick, sensed, f, alpha_ref, flags, before);
             }
         };
         self.set_health(Health::Nominal, &mut flags);
@@ -695,6 +696,14 @@ impl<T: Real> Controller<T> {
             gains: self.cfg.gains,
         };
         let s = law::solve(&law_in)?;
+        // The acceleration's own inputs read again here, where they are used: values held
+        // across the solve would be kept on the stack.
+        let law_in = LawInput {
+            decay_rate_per_s: self.blend_decay_rate_per_s,
+            initial_rate_mps: self.blend_initial_rate_mps,
+            gains: self.cfg.gains,
+            ..law_in
+        };
         let accel = law::acceleration(&law_in, &s)?;
         Ok(LawPart {
             reference: *reference,
@@ -728,7 +737,7 @@ impl<T: Real> Controller<T> {
         tick: u32,
         length_m: T,
         fault: Fault,
-        reference: Option<&Reference<T>>,
+        alpha_ref_rad: Option<T>,
         mut flags: Flags,
         before: Before,
     ) -> Output<T> {
@@ -743,11 +752,11 @@ impl<T: Real> Controller<T> {
         self.set_health(next, &mut flags);
         self.good_ticks = 0;
         // Without a usable sample, α_r is reported at the predicted length.
-        let reference = match reference {
-            Some(r) => *r,
-            None => self.reference(tick, self.length_estimate_m),
+        let alpha_ref_rad = match alpha_ref_rad {
+            Some(a) => a,
+            None => self.reference(tick, self.length_estimate_m).angle.angle_rad,
         };
-        self.hold(tick, &reference, flags, Some(fault), before)
+        self.hold(tick, alpha_ref_rad, flags, Some(fault), before)
     }
 
     /// The safe actions. Degraded: keep the last command (coast). Safe hold: ramp the rate to
@@ -756,7 +765,7 @@ impl<T: Real> Controller<T> {
     fn hold(
         &mut self,
         tick: u32,
-        reference: &Reference<T>,
+        alpha_ref_rad: T,
         mut flags: Flags,
         fault: Option<Fault>,
         before: Before,
@@ -787,7 +796,7 @@ impl<T: Real> Controller<T> {
             law_rate_mps: T::ZERO,
             // (A tick that went backwards is reported at the blend's start.)
             blend_weight: self.blend(tick.max(self.blend_start_tick)).weight,
-            alpha_ref_rad: reference.angle.angle_rad,
+            alpha_ref_rad,
             alpha_ref_rate_radps: T::ZERO,
             delta_rad: T::ZERO,
             delta_rate_radps: T::ZERO,

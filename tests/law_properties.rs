@@ -5,9 +5,11 @@
 //! - Closed-loop identity (Eq. 28): with the blend finished (E = 0), Eq. 26 under the law
 //!   becomes δ̈ + k1 δ̇ + k2 δ = −α̈_r − (2+μ3) α̇_r l̇/l.
 //! - The physical root is the one that tends to the explicit law as p → 0 (linearly).
+//! - A non-finite or absurd input gives a fault, never a number that is not finite (in f64 and
+//!   in the flight build's f32).
 
 use proptest::prelude::*;
-use tss_reel::law::{solve, Blend, Gains, LawInput};
+use tss_reel::law::{acceleration, solve, Blend, Gains, LawInput};
 
 const N: f64 = 1.060_237_230_236_363_5e-3;
 
@@ -100,5 +102,81 @@ proptest! {
             let (d1, d2) = ((y1 - y0).abs(), (y2 - y0).abs());
             prop_assert!(d2 <= 0.2 * d1 + 1e-12 * y0.abs().max(1.0), "y(0) = {y0}, y(p/1e3) = {y1}, y(p/1e4) = {y2}");
         }
+    }
+
+    #[test]
+    fn non_finite_or_huge_inputs_give_a_fault_not_a_number(
+        x in state(),
+        field in 0usize..14,
+        bad in prop::sample::select(vec![f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300, -1e300, 1e30, -1e30]),
+    ) {
+        let x = with_field(x, field, bad);
+        check_finite(&x);
+        check_finite(&to_f32(&x));
+    }
+}
+
+/// `x` with its field number `field` (in declaration order; the blend weight sets both E and
+/// 1 − E) replaced by `v`.
+fn with_field(mut x: LawInput<f64>, field: usize, v: f64) -> LawInput<f64> {
+    match field {
+        0 => x.length_m = v,
+        1 => x.alpha_rad = v,
+        2 => x.alpha_rate_radps = v,
+        3 => x.orbit_rate_radps = v,
+        4 => x.ref_angle_rad = v,
+        5 => x.ref_slope_rad_per_m = v,
+        6 => x.ref_curvature_rad_per_m2 = v,
+        7 => x.ref_time_rate_radps = v,
+        8 => x.mu3 = v,
+        9 => x.mu3_per_m = v,
+        10 => x.blend = Blend::from_weight(v),
+        11 => x.decay_rate_per_s = v,
+        12 => x.initial_rate_mps = v,
+        _ => x.gains.k1_per_s = v,
+    }
+    x
+}
+
+fn to_f32(x: &LawInput<f64>) -> LawInput<f32> {
+    let f = |v: f64| v as f32;
+    LawInput {
+        length_m: f(x.length_m),
+        alpha_rad: f(x.alpha_rad),
+        alpha_rate_radps: f(x.alpha_rate_radps),
+        orbit_rate_radps: f(x.orbit_rate_radps),
+        ref_angle_rad: f(x.ref_angle_rad),
+        ref_slope_rad_per_m: f(x.ref_slope_rad_per_m),
+        ref_curvature_rad_per_m2: f(x.ref_curvature_rad_per_m2),
+        ref_time_rate_radps: f(x.ref_time_rate_radps),
+        mu3: f(x.mu3),
+        mu3_per_m: f(x.mu3_per_m),
+        blend: Blend {
+            weight: f(x.blend.weight),
+            complement: f(x.blend.complement),
+        },
+        decay_rate_per_s: f(x.decay_rate_per_s),
+        initial_rate_mps: f(x.initial_rate_mps),
+        gains: Gains {
+            k1_per_s: f(x.gains.k1_per_s),
+            k2_per_s2: f(x.gains.k2_per_s2),
+        },
+    }
+}
+
+/// Every number the law and the acceleration return as `Ok` at `x` is finite.
+fn check_finite<T: tss_reel::real::Real + core::fmt::Debug>(x: &LawInput<T>) {
+    let Ok(s) = solve(x) else { return };
+    let all = [
+        s.rate_mps,
+        s.law_rate_mps,
+        s.delta_rad,
+        s.delta_rate_radps,
+        s.ref_rate_radps,
+        s.denominator_radps,
+    ];
+    assert!(all.iter().all(|v| v.is_finite()), "{x:?} gave {s:?}");
+    if let Ok(a) = acceleration(x, &s) {
+        assert!(a.is_finite(), "{x:?} gave the acceleration {a:?}");
     }
 }
