@@ -2,18 +2,22 @@
 //!
 //! `libm::sinf` evaluates in f64, which the Cortex-M4F's single-precision FPU emulates in
 //! software (about 1 200 instructions a call, SPEC §8). The law needs sin 2α and cos 2α with
-//! |2α| ≤ 2π, to a few f32 ulps. This module does it in f32 only:
+//! |2α| ≤ 2π, to a few f32 ulps. This module does it in f32 only, from a table:
 //!
-//! 1. Cody–Waite reduction: k = round(x·2/π), r = (x − k·P1) − k·P2 with P1 + P2 = π/2 to
-//!    5·10⁻¹⁵, P1 of 21 significant bits so that k·P1 and x − k·P1 are exact for |k| ≤ 5;
-//! 2. minimax polynomials on [−π/4, π/4] (the Cephes `sinf`/`cosf` coefficients):
-//!    sin r = r + r³(s1 + r²(s2 + r² s3)), cos r = 1 − r²/2 + r⁴(c1 + r²(c2 + r² c3));
-//! 3. the quadrant k mod 4 selects ±sin r or ±cos r.
+//! 1. x = k·h + r with h = 2π/128 and k = round(x/h), r = (x − k·H1) − k·H2 (Cody–Waite:
+//!    H1 + H2 = h to 10⁻¹², H1 of 10 significant bits so that k·H1 and x − k·H1 are exact
+//!    for |k| ≤ 512), so |r| ≤ h/2 ≈ 0.0245;
+//! 2. sin(kh) and cos(kh) from a 160-entry table of sin(2πj/128), j = k mod 128 (one
+//!    bit mask: the table covers the turn and a quarter, so cos kh = sin(kh + π/2) is entry
+//!    j + 32), computed at compile time in f64 and rounded;
+//! 3. sin x = sin kh·cos r + cos kh·sin r (and cos x alike), with sin r = r − r³/6 and
+//!    cos r = 1 − r²/2, whose truncation errors (below 8·10⁻¹¹ and 1.5·10⁻⁸ relative) are
+//!    under an f32 ulp at |r| ≤ h/2.
 //!
-//! Accuracy (proven by this module's tests against f64 `sin`/`cos` over |x| ≤ 8):
-//! absolute error below 2.5e-7 — about two f32 ulps of 1. Arguments beyond [`FAST_RANGE`]
-//! (never produced by the law: its 2α is within ±2π, α being checked to |α| ≤ π) fall back to
-//! `libm`.
+//! Accuracy (proven by this module's tests against f64 `sin`/`cos` on every 64th f32 of
+//! |x| ≤ 2π and at random up to [`FAST_RANGE`]): absolute error below 1.5e-7, about one f32
+//! ulp of 1. Arguments beyond [`FAST_RANGE`] (never produced by the law: its 2α is within
+//! ±2π, α being checked to |α| ≤ π), infinities and NaN fall back to `libm`.
 //!
 //! [`sqrt`] likewise replaces libm's integer `sqrtf` (≈ 75 instructions on the M4F) with a
 //! bit-pattern estimate and Newton steps, within one ulp of the correctly rounded root.
@@ -31,22 +35,30 @@
 //! Rounding to an integer uses the classic `(v + 1.5·2²³) − 1.5·2²³`, which the FPU rounds to
 //! nearest-even exactly as `rintf` does for |v| < 2²² (LLVM keeps the pair: no fast-math).
 
-/// Largest |x| handled by the fast path (it covers the law's |2α| ≤ 2π); beyond it `libm` is
-/// used.
-pub const FAST_RANGE: f32 = 8.0;
+/// |x| up to which [`sin_cos`] takes the table (|k| < 512 steps of h = 2π/128, with a margin;
+/// it covers the law's |2α| ≤ 2π four times over); beyond it `libm` is used.
+pub const FAST_RANGE: f32 = 25.0;
 
-const TWO_OVER_PI: f32 = core::f32::consts::FRAC_2_PI;
-// π/2 = P1 + P2 + 5.3e-15: P1 = round(π/2·2²⁰)/2²⁰ (21 significant bits, so k·P1 is exact for
-// |k| ≤ 5 = round(8·2/π)), P2 = π/2 − P1 rounded to f32.
-const P1: f32 = 1_647_099.0 / 1_048_576.0;
-const P2: f32 = 3.139_164_7e-7;
-// Cephes sinf/cosf minimax coefficients on [−π/4, π/4].
-const S1: f32 = -0.16666655;
-const S2: f32 = 0.008332161;
-const S3: f32 = -0.00019515296;
-const C1: f32 = 0.041666646;
-const C2: f32 = -0.0013887316;
-const C3: f32 = 2.4433157e-05;
+/// Table steps per turn.
+const STEPS: u32 = 128;
+/// Table length: a turn and a quarter, so that cos of step j is entry j + STEPS/4.
+const TABLE_LEN: usize = STEPS as usize * 5 / 4;
+/// sin(2πj/[`STEPS`]) for j = 0 … [`TABLE_LEN`] − 1, rounded to f32.
+static SIN_TABLE: [f32; TABLE_LEN] = sin_table();
+/// 1/h.
+const STEPS_PER_RAD: f32 = (STEPS as f64 / core::f64::consts::TAU) as f32;
+// h = H1 + H2 to 10⁻¹²: H1 = h rounded down to a multiple of 2⁻¹⁴ (804·2⁻¹⁴, 10 significant
+// bits, so k·H1 is exact for |k| ≤ 512), H2 = h − H1 rounded to f32.
+const H1: f32 = 804.0 / 16_384.0;
+const H2: f32 = (core::f64::consts::TAU / STEPS as f64 - 804.0 / 16_384.0) as f32;
+/// 2²³ + 512: x/h + this is 2²³ + 512 + round(x/h) for |x/h| < 512 (the ulp is 1 in
+/// [2²³, 2²⁴)), whose bit pattern is 2²³'s plus 512 + k: one unsigned comparison tests the
+/// range (NaN and ±∞ fail it), and the low bits are k mod 128.
+const K_ROUNDER: f32 = 8_389_120.0;
+const TWO_23_BITS: u32 = 8_388_608.0_f32.to_bits();
+// The fast path's range test admits every |x| ≤ FAST_RANGE (|x/h| < 511), with the rounder
+// as documented.
+const _: () = assert!(FAST_RANGE * STEPS_PER_RAD < 511.0 && K_ROUNDER == 8_388_608.0 + 512.0);
 
 /// 1.5·2²³: adding and subtracting it rounds an f32 of magnitude below 2²² to the nearest
 /// integer (ties to even) in the FPU's default rounding mode.
@@ -58,28 +70,60 @@ fn round_small(v: f32) -> f32 {
     (v + ROUNDER) - ROUNDER
 }
 
-/// `(sin x, cos x)` in single precision (see the module docs for the accuracy).
+/// `(sin x, cos x)` in single precision (see the module docs for the method and accuracy).
 #[inline]
-#[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a <= b)` is meant: it is true for NaN.
 pub fn sin_cos(x: f32) -> (f32, f32) {
-    // NaN fails the comparison: NaN, ±inf and huge arguments get libm's answer.
-    if !(x.abs() <= FAST_RANGE) {
+    let rounded = x * STEPS_PER_RAD + K_ROUNDER;
+    let bits = rounded.to_bits();
+    if bits.wrapping_sub(TWO_23_BITS) >= 1024 {
         return (libm::sinf(x), libm::cosf(x));
     }
-    // |x·2/π| ≤ 5.1 < 2²².
-    let k = round_small(x * TWO_OVER_PI);
-    // x − k·P1 is exact (k·P1 is, and x lies within a factor 1 ± 1/(2|k|) of it).
-    let r = (x - k * P1) - k * P2;
+    let k = rounded - K_ROUNDER;
+    let r = (x - k * H1) - k * H2;
+    let j = (bits & (STEPS - 1)) as usize;
+    let (sin_kh, cos_kh) = (SIN_TABLE[j], SIN_TABLE[j + STEPS as usize / 4]);
     let z = r * r;
-    let s = r + r * z * (S1 + z * (S2 + z * S3));
-    let c = 1.0 - 0.5 * z + z * z * (C1 + z * (C2 + z * C3));
-    // |k| ≤ 5: the conversion is exact.
-    match (k as i32) & 3 {
-        0 => (s, c),
-        1 => (c, -s),
-        2 => (-s, -c),
-        _ => (-c, s),
+    let sin_r = r + r * z * (-1.0 / 6.0);
+    let cos_r_minus_1 = -0.5 * z;
+    (
+        sin_kh + (sin_kh * cos_r_minus_1 + cos_kh * sin_r),
+        cos_kh + (cos_kh * cos_r_minus_1 - sin_kh * sin_r),
+    )
+}
+
+/// (sin a, cos a) in f64 for 0 ≤ a < π/2 by their Taylor series (terms to a³⁹/39!, far below
+/// an f64 ulp), at compile time.
+const fn taylor_sin_cos(a: f64) -> (f64, f64) {
+    let (mut sin, mut cos) = (0.0, 0.0);
+    let (mut sin_term, mut cos_term) = (a, 1.0);
+    let mut k = 0;
+    while k < 40 {
+        cos += cos_term;
+        sin += sin_term;
+        cos_term *= -a * a / ((k + 1) * (k + 2)) as f64;
+        sin_term *= -a * a / ((k + 2) * (k + 3)) as f64;
+        k += 2;
     }
+    (sin, cos)
+}
+
+/// [`SIN_TABLE`]: each quadrant from the first one's sines and cosines.
+const fn sin_table() -> [f32; TABLE_LEN] {
+    let quarter = STEPS as usize / 4;
+    let mut table = [0.0; TABLE_LEN];
+    let mut j = 0;
+    while j < TABLE_LEN {
+        let a = (j % quarter) as f64 * (core::f64::consts::TAU / STEPS as f64);
+        let (sin, cos) = taylor_sin_cos(a);
+        table[j] = match (j / quarter) % 4 {
+            0 => sin,
+            1 => cos,
+            2 => -sin,
+            _ => -cos,
+        } as f32;
+        j += 1;
+    }
+    table
 }
 
 /// √x in single precision without leaving the FPU's precision (libm's `sqrtf` is a bit-serial
@@ -178,17 +222,45 @@ pub fn exp_and_complement(x: f32) -> (f32, f32) {
 /// reduction needs no two-part ln 2: the fraction t − round(t) is exact.
 ///
 /// The fast path is [`EXP2_FAST_MIN`] ≤ t ≤ −0 (one unsigned comparison of the bit pattern);
-/// everything else is libm's.
+/// everything else takes [`exp2_special`] (out of line, without libm).
 #[inline]
 pub fn exp2_and_complement(t: f32) -> (f32, f32) {
     const NEG_ZERO: u32 = 0x8000_0000;
     const SPAN: u32 = EXP2_FAST_MIN.to_bits() - NEG_ZERO;
     if t.to_bits().wrapping_sub(NEG_ZERO) > SPAN {
-        return (libm::exp2f(t), -libm::expm1f(t * LN_2));
+        return exp2_special(t);
     }
     // −126 ≤ k ≤ 0; t − k is exact (|t − k| ≤ ½, and t and k are multiples of t's ulp).
     let k = round_small(t);
     let r = (t - k) * LN_2;
+    two_to_k_times_exp(k, r)
+}
+
+/// [`exp2_and_complement`] outside its fast range: NaN gives NaN; below −150, (0, 1); from
+/// −150 to −126, where 2^t is subnormal, 2^{t+64}·2⁻⁶⁴ (t + 64 is exact, the scaling rounds
+/// once) with the complement 1; from +0 up, the same kernel with 2^k up to 2¹²⁷ (2¹²⁸ as
+/// 2·2¹²⁷), overflowing to +∞ at 128. Out of line: the blend's argument is never here, and
+/// it keeps libm's `exp2f` and `expm1f` out of the firmware.
+#[inline(never)]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(t >= …)` is meant: it is true for NaN.
+fn exp2_special(t: f32) -> (f32, f32) {
+    const TWO_TO_MINUS_64: f32 = 1.0 / 18_446_744_073_709_551_616.0;
+    if !(t >= -150.0) {
+        return if t.is_nan() { (t, t) } else { (0.0, 1.0) };
+    }
+    if t < EXP2_FAST_MIN {
+        return (exp2_and_complement(t + 64.0).0 * TWO_TO_MINUS_64, 1.0);
+    }
+    if t >= 128.0 {
+        return (f32::INFINITY, f32::NEG_INFINITY);
+    }
+    // +0 ≤ t < 128: 0 ≤ k ≤ 128, t − k exact as in the fast path.
+    let k = round_small(t);
+    let r = (t - k) * LN_2;
+    if k > 127.0 {
+        let e = 2.0 * two_to_k_times_exp(127.0, r).0;
+        return (e, 1.0 - e);
+    }
     two_to_k_times_exp(k, r)
 }
 
@@ -246,7 +318,7 @@ mod tests {
             [x, -x]
         });
         let (e, at) = worst_error(xs);
-        assert!(e < 2.5e-7, "max error {e:e} at x = {at}");
+        assert!(e < 1.5e-7, "max error {e:e} at x = {at}");
     }
 
     #[test]
@@ -259,7 +331,7 @@ mod tests {
             ((seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) as f32 * FAST_RANGE
         });
         let (e, at) = worst_error(xs);
-        assert!(e < 2.5e-7, "max error {e:e} at x = {at}");
+        assert!(e < 1.5e-7, "max error {e:e} at x = {at}");
     }
 
     #[test]
@@ -390,20 +462,40 @@ mod tests {
             let t = -(k as f32);
             assert_eq!(exp2_and_complement(t).0, libm::exp2f(t), "{t}");
         }
-        // Outside: libm's.
-        for t in [
-            0.0_f32,
-            0.5,
-            -126.000_01,
-            -150.0,
-            f32::NEG_INFINITY,
-            f32::INFINITY,
-        ] {
-            let (e, c) = exp2_and_complement(t);
-            assert_eq!(e.to_bits(), libm::exp2f(t).to_bits(), "{t}");
-            assert_eq!(c.to_bits(), (-libm::expm1f(t * LN_2)).to_bits(), "{t}");
-        }
         assert!(exp2_and_complement(f32::NAN).0.is_nan());
+        assert!(exp2_and_complement(f32::NAN).1.is_nan());
+    }
+
+    #[test]
+    fn exp2_outside_the_fast_range_is_within_two_ulps() {
+        // Every 16th f32 of [−150, −126) (subnormal results: within 1 ulp of the subnormal)
+        // and of [+0, 128) (normal results up to overflow).
+        let below = (EXP2_FAST_MIN.to_bits() + 1..=(-150.0_f32).to_bits()).step_by(16);
+        let above = (0..128.0_f32.to_bits()).step_by(16);
+        for bits in below.chain(above) {
+            let t = f32::from_bits(bits);
+            let (e, c) = exp2_and_complement(t);
+            let td = f64::from(t);
+            assert!(ulps(e, libm::exp2(td)) <= 2, "2^{t:e} = {e:e}");
+            let exact_c = -libm::expm1(td * core::f64::consts::LN_2);
+            // (±0 compare equal: 1 − 2^{+0} is +0 here, −expm1(+0) is −0.)
+            assert!(
+                c == exact_c as f32 || ulps(c, exact_c) <= 2,
+                "1 − 2^{t:e} = {c:e}"
+            );
+        }
+        for (t, e, c) in [
+            (0.0_f32, 1.0_f32, 0.0_f32),
+            (1.0, 2.0, -1.0),
+            (127.0, 1.701_411_8e38, -1.701_411_8e38),
+            (128.0, f32::INFINITY, f32::NEG_INFINITY),
+            (f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY),
+            (-150.000_02, 0.0, 1.0),
+            (f32::NEG_INFINITY, 0.0, 1.0),
+        ] {
+            assert_eq!(exp2_and_complement(t), (e, c), "{t}");
+        }
+        assert_eq!(exp2_and_complement(-149.0).0, f32::from_bits(1));
     }
 
     #[test]
@@ -459,20 +551,24 @@ mod tests {
     }
 
     #[test]
-    fn reduction_constants_are_as_documented() {
-        let half_pi = core::f64::consts::FRAC_PI_2;
-        assert_eq!(
-            f64::from(P1),
-            libm::round(half_pi * 1_048_576.0) / 1_048_576.0
-        );
-        assert_eq!(P2, (half_pi - f64::from(P1)) as f32);
-        assert!((half_pi - f64::from(P1) - f64::from(P2)).abs() < 6e-15);
-        // k·P1 exact for every k of the fast range.
-        let k_max = libm::rintf(FAST_RANGE * TWO_OVER_PI);
-        assert_eq!(k_max, 5.0);
-        for k in 1..=5 {
+    fn reduction_constants_and_table_are_as_documented() {
+        let h = core::f64::consts::TAU / f64::from(STEPS);
+        assert_eq!(f64::from(H1), libm::floor(h * 16_384.0) / 16_384.0);
+        assert_eq!(H2, (h - f64::from(H1)) as f32);
+        assert!((h - f64::from(H1) - f64::from(H2)).abs() < 1e-12);
+        // k·H1 exact for every k of the fast path.
+        for k in -512..=512 {
             let k = k as f32;
-            assert_eq!(f64::from(k * P1), f64::from(k) * f64::from(P1));
+            assert_eq!(f64::from(k * H1), f64::from(k) * f64::from(H1));
+        }
+        // The compile-time table is f64's sine, rounded (its zeros exact: f64's sin(jh) is
+        // about 1e-16 there, from the rounding of jh).
+        for (j, &v) in SIN_TABLE.iter().enumerate() {
+            let exact = libm::sin(j as f64 * h);
+            assert!(
+                v == exact as f32 || (v == 0.0 && exact.abs() < 1e-15),
+                "entry {j}: {v:e}, f64 {exact:e}"
+            );
         }
     }
 
@@ -481,8 +577,8 @@ mod tests {
         for k in -20..=20 {
             let x = k as f32 * core::f32::consts::FRAC_PI_2;
             let (s, c) = sin_cos(x);
-            assert!((f64::from(s) - libm::sin(f64::from(x))).abs() < 2.5e-7);
-            assert!((f64::from(c) - libm::cos(f64::from(x))).abs() < 2.5e-7);
+            assert!((f64::from(s) - libm::sin(f64::from(x))).abs() < 1.5e-7);
+            assert!((f64::from(c) - libm::cos(f64::from(x))).abs() < 1.5e-7);
         }
         assert_eq!(sin_cos(0.0), (0.0, 1.0));
         assert!(sin(f32::NAN).is_nan() && cos(f32::INFINITY).is_nan());

@@ -251,14 +251,18 @@ fn whole_mission_f32_vs_f64() {
     assert_eq!(f.state_mismatches, 0);
     // The goal holds at every step except where the law itself is too ill-conditioned for
     // any f32 evaluation: the f64 command moves by more than the goal when α moves by half
-    // an f32 spacing (measured: median 2.8e-8, max 3.6e-5, 9 of 72 001 steps above 1e-5, all
+    // an f32 spacing (measured: median 2.9e-8, max 1.02e-4, 11 of 72 001 steps above 1e-5, all
     // in the stage-1 keep, at the turning points of its first swing (31.3 km and 29.6 km, the
-    // command a few mm/s) where that effect reaches 5.7e-5; the largest difference 6e-8 m/s). Two earlier f32 losses are gone and stay
-    // gone: the quintic transitions are evaluated from the nearer band end (2.6e-2 at the
-    // keeps), and 1 − E of the blend is computed as −expm1(−cτ), not from the rounded E (5.8e-5
-    // right after the stage-2 restart, E ≈ 1).
+    // command a few mm/s) where that effect reaches 5.7e-5; the largest difference 1.8e-7
+    // m/s). There one f32 ulp of sin 2α moves the command as much as α's rounding does: the
+    // max was 3.6e-5 with the earlier polynomial sine, 1.02e-4 with the table sine (both
+    // within their 1.5 to 2.5e-7 bounds), so the cap below is 2e-4, and every step above the
+    // goal is still within 4× the input-rounding effect. Two earlier f32 losses are gone and
+    // stay gone: the quintic transitions are evaluated from the nearer band end (2.6e-2 at
+    // the keeps), and 1 − E of the blend is computed as −expm1(−cτ), not from the rounded E
+    // (5.8e-5 right after the stage-2 restart, E ≈ 1).
     assert_eq!(f.unexplained, 0, "{:?}", f.worst);
-    assert!(f.worst.rel <= 1e-4, "{:?}", f.worst);
+    assert!(f.worst.rel <= 2e-4, "{:?}", f.worst);
     assert!(f.worst.abs_mps <= 1e-6, "{:?}", f.worst);
     assert!(
         f.above_goal() * 5000 <= f.rels.len(),
