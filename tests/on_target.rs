@@ -130,7 +130,7 @@ mod tests {
             let err = (f64::from(s) - libm::sin(xd))
                 .abs()
                 .max((f64::from(c) - libm::cos(xd)).abs());
-            defmt::assert!(err < 2.5e-7, "x = {=f32}: error {=f64}", x, err);
+            defmt::assert!(err < 1.5e-7, "x = {=f32}: error {=f64}", x, err);
             x += 0.0137;
         }
     }
