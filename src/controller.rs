@@ -368,6 +368,8 @@ struct LawPart<T> {
     ref_rate_radps: T,
     delta_rad: T,
     delta_rate_radps: T,
+    /// L′ = l/(2 + μ3), m.
+    reduced_length_m: T,
 }
 
 impl<T: Real> Controller<T> {
@@ -595,7 +597,10 @@ impl<T: Real> Controller<T> {
         };
         self.last_rate_cmd_mps = rate;
         self.update_phase(x.length_m, law.reference.slewing);
-        let margin = self.equilibrium_margin(mu3, x.length_m, rate, &mut flags);
+        let x_rate = self
+            .existence
+            .normalised_rate_at_reduced_length(law.reduced_length_m, rate);
+        let margin = self.equilibrium_margin(x_rate, mu3, x.length_m, rate, &mut flags);
         self.note_events(tick, before, None, flags);
         Output {
             tick,
@@ -713,6 +718,7 @@ impl<T: Real> Controller<T> {
             ref_rate_radps: s.ref_rate_radps,
             delta_rad: s.delta_rad,
             delta_rate_radps: s.delta_rate_radps,
+            reduced_length_m: s.reduced_length_m,
         })
     }
 
@@ -785,7 +791,9 @@ impl<T: Real> Controller<T> {
         flags.set(sat.0 & Flags::LENGTH_LIMITED);
         self.last_rate_cmd_mps = rate;
         let mu3 = self.mu3_and_slope(self.length_estimate_m).0;
-        let margin = self.equilibrium_margin(mu3, self.length_estimate_m, rate, &mut flags);
+        let l = self.length_estimate_m;
+        let x_rate = self.existence.normalised_rate(mu3, l, rate);
+        let margin = self.equilibrium_margin(x_rate, mu3, l, rate, &mut flags);
         self.note_events(tick, before, fault, flags);
         Output {
             tick,
@@ -807,15 +815,16 @@ impl<T: Real> Controller<T> {
         }
     }
 
-    /// The Eq. 13 margin of the command (whole orbit), flagging a command outside the region.
+    /// The Eq. 13 margin of the command `rate_mps` at `length_m` (whole orbit), flagging a
+    /// command outside the region. `x` is its normalised rate (Eq. 7), which the caller forms:
+    /// from the law's L′ = l/(2 + μ3) on the law's path, from μ3 and l on a safe action.
     ///
     /// The common case takes one comparison: a normalised rate x of moderate size, whose
     /// margin is within the reported bound as it is (|margin| ≤ |x| + the extent's width, far
     /// below [`MAX_REPORTED_MARGIN`]). NaN, infinities and huge values (a length estimate
     /// near zero) fail it and take [`Self::far_equilibrium_margin`].
     #[inline(always)]
-    fn equilibrium_margin(&self, mu3: T, length_m: T, rate_mps: T, flags: &mut Flags) -> T {
-        let x = self.existence.normalised_rate(mu3, length_m, rate_mps);
+    fn equilibrium_margin(&self, x: T, mu3: T, length_m: T, rate_mps: T, flags: &mut Flags) -> T {
         let (margin, outside) = if x.abs() <= T::from_f64(MODERATE_NORMALISED_RATE) {
             let m = self.existence.whole_orbit_margin_of(x);
             (m, m < T::ZERO)

@@ -484,6 +484,13 @@ impl<T: Real> ExistenceMonitor<T> {
         normalised_rate(mu3, length_rate_mps / length_m, self.mean_motion_radps)
     }
 
+    /// [`normalised_rate`](Self::normalised_rate) from the reduced length L′ = l/(2 + μ3)
+    /// (m) the law has already formed: x = l̇/(ω L′).
+    #[inline(always)]
+    pub fn normalised_rate_at_reduced_length(&self, reduced_length_m: T, length_rate_mps: T) -> T {
+        length_rate_mps / (reduced_length_m * self.mean_motion_radps)
+    }
+
     /// The signed whole-orbit (Eq. 13) margin of a finite normalised rate `x`:
     /// min(min Depl − x, x − max Retr), ≥ 0 exactly when an equilibrium exists over the whole
     /// orbit.
