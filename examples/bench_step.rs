@@ -444,8 +444,12 @@ mod bench {
             });
             let mut copies: [Controller<f32>; K] = core::array::from_fn(|_| ctl.clone());
             let cost = match &input {
-                Some(x) => m.per_call(&mut copies, |c| c.step(black_box(x))),
-                None => m.per_call(&mut copies, |c| c.step_missing(black_box(tick))),
+                Some(x) => m.per_call(&mut copies, |c| {
+                    black_box(c.step(black_box(x)));
+                }),
+                None => m.per_call(&mut copies, |c| {
+                    black_box(c.step_missing(black_box(tick)));
+                }),
             };
             let out = match &input {
                 Some(x) => ctl.step(x),
@@ -463,7 +467,7 @@ mod bench {
                     previous_rate = out.rate_cmd_mps;
                     continue;
                 }
-                let parts = time_parts(m, &cfg, &existence, &bands, x, &out, previous_rate);
+                let parts = time_parts(m, &cfg, &existence, &bands, x, out, previous_rate);
                 let mut sum = 0;
                 for (s, &v) in r.parts.iter_mut().zip(&parts) {
                     s.add(v, tick);

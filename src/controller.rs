@@ -208,58 +208,70 @@ pub struct Event {
     pub kind: EventKind,
 }
 
-/// The controller's event queue: a ring of [`EVENT_CAPACITY`] events that drops (and counts)
-/// the oldest when a new one finds it full. A push is a handful of instructions with no
-/// branches beyond the full check, so a step that records events stays close to a quiet one.
+/// The controller's event queue: a ring of [`EVENT_CAPACITY`] events in which a new event
+/// overwrites the oldest unread one when the ring is full. The writer and the reader each
+/// keep a free-running count (wrapping): a push is one store and one increment, with no test,
+/// so a step that records events stays close to a quiet one; the reader finds any events
+/// overwritten since it last read (more than [`EVENT_CAPACITY`] unread) and counts them as
+/// dropped.
 #[derive(Clone, Debug)]
 struct EventRing {
     buf: [Event; EVENT_CAPACITY],
-    /// Index of the oldest unread event.
-    head: usize,
-    /// Unread events, at most [`EVENT_CAPACITY`].
-    len: usize,
-    /// Events dropped because the ring was full.
+    /// Events ever written (wrapping); the next is written at `written mod capacity`.
+    written: u32,
+    /// Events ever read or dropped (wrapping).
+    read: u32,
+    /// Events dropped, up to the last read.
     dropped: u32,
 }
 
-const _: () = assert!(EVENT_CAPACITY.is_power_of_two());
+const _: () = assert!(EVENT_CAPACITY.is_power_of_two() && EVENT_CAPACITY <= u32::MAX as usize);
 
 impl EventRing {
+    const CAPACITY: u32 = EVENT_CAPACITY as u32;
+
     const fn new() -> Self {
         Self {
             buf: [Event {
                 tick: 0,
                 kind: EventKind::BlendRestart,
             }; EVENT_CAPACITY],
-            head: 0,
-            len: 0,
+            written: 0,
+            read: 0,
             dropped: 0,
         }
     }
 
-    /// Appends `e`; when the ring is full the oldest event makes room (and is counted).
+    /// Appends `e`; when the ring is full it takes the oldest unread event's slot.
     #[inline(always)]
     fn push(&mut self, e: Event) {
-        const MASK: usize = EVENT_CAPACITY - 1;
-        // head, len ≤ EVENT_CAPACITY: no wrap-around; when full the slot is the oldest's.
-        self.buf[self.head.wrapping_add(self.len) & MASK] = e;
-        if self.len == EVENT_CAPACITY {
-            self.head = self.head.wrapping_add(1) & MASK;
-            self.dropped = self.dropped.saturating_add(1);
-        } else {
-            self.len = self.len.wrapping_add(1);
-        }
+        self.buf[self.written as usize & (EVENT_CAPACITY - 1)] = e;
+        self.written = self.written.wrapping_add(1);
     }
 
-    /// Takes the oldest unread event.
+    /// Unread events overwritten since the last read.
+    fn overwritten(&self) -> u32 {
+        self.written
+            .wrapping_sub(self.read)
+            .saturating_sub(Self::CAPACITY)
+    }
+
+    /// Takes the oldest unread event (first counting any that were overwritten).
     fn pop(&mut self) -> Option<Event> {
-        if self.len == 0 {
+        let lost = self.overwritten();
+        self.dropped = self.dropped.saturating_add(lost);
+        self.read = self.read.wrapping_add(lost);
+        if self.read == self.written {
             return None;
         }
-        let e = self.buf[self.head];
-        self.head = (self.head + 1) & (EVENT_CAPACITY - 1);
-        self.len -= 1;
+        let e = self.buf[self.read as usize & (EVENT_CAPACITY - 1)];
+        self.read = self.read.wrapping_add(1);
         Some(e)
+    }
+
+    /// Events dropped so far, including those overwritten and not yet counted by a read.
+    fn dropped(&self) -> u32 {
+        self.dropped.saturating_add(self.overwritten())
     }
 }
 
@@ -308,6 +320,9 @@ pub struct Controller<T: Real> {
     /// Events not yet read, oldest first; when full the oldest is dropped and counted.
     events: EventRing,
     last_fault: Option<Fault>,
+    /// The last step's output ([`Controller::output`]); each step writes its parts as they
+    /// become known (values written early need no register until the end of the step).
+    out: Output<T>,
 }
 
 /// What a step needs of the configuration beyond its plain numbers, worked out once in
@@ -409,6 +424,23 @@ impl<T: Real> Controller<T> {
             anchored: false,
             events: EventRing::new(),
             last_fault: None,
+            out: Output {
+                tick: 0,
+                phase: Phase::Deploy,
+                health: Health::Nominal,
+                rate_cmd_mps: T::ZERO,
+                accel_cmd_mps2: T::ZERO,
+                law_rate_mps: T::ZERO,
+                blend_weight: T::ONE,
+                alpha_ref_rad: T::ZERO,
+                alpha_ref_rate_radps: T::ZERO,
+                delta_rad: T::ZERO,
+                delta_rate_radps: T::ZERO,
+                length_estimate_m: T::ZERO,
+                equilibrium_margin: T::ZERO,
+                flags: Flags(0),
+                fault: None,
+            },
             cfg,
         })
     }
@@ -428,6 +460,12 @@ impl<T: Real> Controller<T> {
         self.health
     }
 
+    /// The last step's output. Before the first step: tick 0, a zero rate and acceleration,
+    /// blend weight 1, the stage-1 phase and nominal health, no flags and no fault.
+    pub fn output(&self) -> &Output<T> {
+        &self.out
+    }
+
     /// The oldest unread event (health and phase changes, faults, blend restarts), if any.
     ///
     /// The queue holds [`EVENT_CAPACITY`] events; read it every period so none are dropped
@@ -438,7 +476,7 @@ impl<T: Real> Controller<T> {
 
     /// Events dropped because the queue was full when they happened.
     pub fn events_dropped(&self) -> u32 {
-        self.events.dropped
+        self.events.dropped()
     }
 
     #[inline(always)]
@@ -453,18 +491,23 @@ impl<T: Real> Controller<T> {
         }
     }
 
-    /// One control period with a fresh sensor sample.
-    pub fn step(&mut self, input: &Input<T>) -> Output<T> {
-        self.advance(input.tick, Some(input))
+    /// One control period with a fresh sensor sample. The output stays in the controller until
+    /// the next step ([`Controller::output`]): the step writes each part of it as soon as it
+    /// is known, and nothing is copied.
+    pub fn step(&mut self, input: &Input<T>) -> &Output<T> {
+        self.advance(input.tick, Some(input));
+        &self.out
     }
 
     /// One control period in which no sample arrived (a sensor dropout): the controller coasts
-    /// on the predicted length, then goes to safe hold (see [`Health`]).
-    pub fn step_missing(&mut self, tick: u32) -> Output<T> {
-        self.advance(tick, None)
+    /// on the predicted length, then goes to safe hold (see [`Health`]). The output is kept as
+    /// [`Controller::step`]'s is.
+    pub fn step_missing(&mut self, tick: u32) -> &Output<T> {
+        self.advance(tick, None);
+        &self.out
     }
 
-    fn advance(&mut self, tick: u32, sample: Option<&Input<T>>) -> Output<T> {
+    fn advance(&mut self, tick: u32, sample: Option<&Input<T>>) {
         let before = Before {
             health: self.health,
             phase: self.phase,
@@ -499,7 +542,7 @@ impl<T: Real> Controller<T> {
         }
     }
 
-    fn advance_inner(&mut self, tick: u32, sample: Option<&Input<T>>, before: Before) -> Output<T> {
+    fn advance_inner(&mut self, tick: u32, sample: Option<&Input<T>>, before: Before) {
         let mut flags = Flags::default();
         let dt = self.cfg.period_s;
         // A tick that goes backwards is a bad sample; time does not move.
@@ -576,6 +619,12 @@ impl<T: Real> Controller<T> {
                 return self.reject(tick, sensed, f, alpha_ref, flags, before);
             }
         };
+        self.out.law_rate_mps = law.law_rate_mps;
+        self.out.blend_weight = blend.weight;
+        self.out.alpha_ref_rad = law.reference.angle.angle_rad;
+        self.out.alpha_ref_rate_radps = law.ref_rate_radps;
+        self.out.delta_rad = law.delta_rad;
+        self.out.delta_rate_radps = law.delta_rate_radps;
         self.set_health(Health::Nominal, &mut flags);
         self.bad_ticks = 0;
 
@@ -596,29 +645,21 @@ impl<T: Real> Controller<T> {
             law.accel_mps2
         };
         self.last_rate_cmd_mps = rate;
+        self.out.rate_cmd_mps = rate;
+        self.out.accel_cmd_mps2 = accel;
         self.update_phase(x.length_m, law.reference.slewing);
         let x_rate = self
             .existence
             .normalised_rate_at_reduced_length(law.reduced_length_m, rate);
         let margin = self.equilibrium_margin(x_rate, mu3, x.length_m, rate, &mut flags);
         self.note_events(tick, before, None, flags);
-        Output {
-            tick,
-            phase: self.phase,
-            health: self.health,
-            rate_cmd_mps: rate,
-            accel_cmd_mps2: accel,
-            law_rate_mps: law.law_rate_mps,
-            blend_weight: blend.weight,
-            alpha_ref_rad: law.reference.angle.angle_rad,
-            alpha_ref_rate_radps: law.ref_rate_radps,
-            delta_rad: law.delta_rad,
-            delta_rate_radps: law.delta_rate_radps,
-            length_estimate_m: self.length_estimate_m,
-            equilibrium_margin: margin,
-            flags,
-            fault: None,
-        }
+        self.out.tick = tick;
+        self.out.phase = self.phase;
+        self.out.health = self.health;
+        self.out.length_estimate_m = x.length_m;
+        self.out.equilibrium_margin = margin;
+        self.out.flags = flags;
+        self.out.fault = None;
     }
 
     /// (μ3, dμ3/dl) at `length_m` (Eq. 5's mass coefficient, [`crate::mass::MassModel`]):
@@ -746,7 +787,7 @@ impl<T: Real> Controller<T> {
         alpha_ref_rad: Option<T>,
         mut flags: Flags,
         before: Before,
-    ) -> Output<T> {
+    ) {
         self.length_estimate_m = length_m.clamp_finite(T::ZERO, self.derived.spool_m);
         self.bad_ticks = self.bad_ticks.saturating_add(1);
         let next =
@@ -775,7 +816,7 @@ impl<T: Real> Controller<T> {
         mut flags: Flags,
         fault: Option<Fault>,
         before: Before,
-    ) -> Output<T> {
+    ) {
         flags.set(Flags::SAFE_ACTION);
         let dt = self.cfg.period_s;
         let prev = self.last_rate_cmd_mps;
@@ -795,7 +836,7 @@ impl<T: Real> Controller<T> {
         let x_rate = self.existence.normalised_rate(mu3, l, rate);
         let margin = self.equilibrium_margin(x_rate, mu3, l, rate, &mut flags);
         self.note_events(tick, before, fault, flags);
-        Output {
+        self.out = Output {
             tick,
             phase: self.phase,
             health: self.health,
@@ -812,7 +853,7 @@ impl<T: Real> Controller<T> {
             equilibrium_margin: margin,
             flags,
             fault,
-        }
+        };
     }
 
     /// The Eq. 13 margin of the command `rate_mps` at `length_m` (whole orbit), flagging a
@@ -878,5 +919,65 @@ impl<T: Real> Controller<T> {
             Phase::Keep1 | Phase::Slew | Phase::Keep2 => (T::ONE, never),
         };
         self.phase = phase;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::{Event, EventKind, EventRing, Phase, EVENT_CAPACITY};
+    use std::{vec, vec::Vec};
+
+    fn event(i: u32) -> Event {
+        Event {
+            tick: i,
+            kind: EventKind::Phase(Phase::Deploy),
+        }
+    }
+
+    fn drain(ring: &mut EventRing) -> Vec<u32> {
+        core::iter::from_fn(|| ring.pop()).map(|e| e.tick).collect()
+    }
+
+    #[test]
+    fn ring_keeps_the_newest_and_counts_the_overwritten() {
+        let mut ring = EventRing::new();
+        assert_eq!(ring.pop(), None);
+        for i in 0..3 {
+            ring.push(event(i));
+        }
+        assert_eq!((drain(&mut ring), ring.dropped()), (vec![0, 1, 2], 0));
+        // 16 + 5 unread: the 5 oldest are overwritten, counted before and after the read.
+        for i in 3..3 + EVENT_CAPACITY as u32 + 5 {
+            ring.push(event(i));
+        }
+        assert_eq!(ring.dropped(), 5);
+        let expected: Vec<u32> = (8..24).collect();
+        assert_eq!(drain(&mut ring), expected);
+        assert_eq!(ring.dropped(), 5);
+        // A partial read, then more than a ring's worth: only the unread are lost.
+        for i in 24..30 {
+            ring.push(event(i));
+        }
+        assert_eq!(ring.pop().map(|e| e.tick), Some(24));
+        for i in 30..50 {
+            ring.push(event(i));
+        }
+        assert_eq!(ring.dropped(), 5 + 9);
+        assert_eq!(drain(&mut ring), (34..50).collect::<Vec<u32>>());
+    }
+
+    #[test]
+    fn ring_counters_wrap_around() {
+        let mut ring = EventRing::new();
+        ring.written = u32::MAX - 2;
+        ring.read = u32::MAX - 2;
+        for i in 0..EVENT_CAPACITY as u32 + 2 {
+            ring.push(event(i));
+        }
+        assert_eq!(ring.written, EVENT_CAPACITY as u32 - 1);
+        assert_eq!(ring.dropped(), 2);
+        assert_eq!(drain(&mut ring), (2..18).collect::<Vec<u32>>());
+        assert_eq!((ring.pop(), ring.dropped()), (None, 2));
     }
 }

@@ -117,12 +117,11 @@ pub struct Devices<L, S, O, R> {
     pub reel: R,
 }
 
-/// What one control cycle did.
+/// What one control cycle did besides stepping the controller (its output, already sent to
+/// the reel unless `reel_error` is set, is [`Controller::output`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub struct Cycle {
-    /// The controller's output (already sent to the reel unless `reel_error` is set).
-    pub output: Output<f32>,
     /// The first sensor error of this period, if any (the controller treated it as a dropout).
     pub sensor_error: Option<ErrorKind>,
     /// The reel drive's error, if it refused the command.
@@ -164,9 +163,8 @@ where
         Ok(input) => (controller.step(&input), None),
         Err(kind) => (controller.step_missing(tick), Some(kind)),
     };
-    let reel_error = dev.reel.command(&output).err().map(|e| e.kind());
+    let reel_error = dev.reel.command(output).err().map(|e| e.kind());
     Cycle {
-        output,
         sensor_error,
         reel_error,
     }
@@ -242,11 +240,12 @@ mod tests {
             reel: &mut reel,
         };
         let c0 = control_cycle(&mut ctl, 0, &mut dev);
-        assert!(c0.sensor_error.is_none() && c0.output.fault.is_none());
+        assert!(c0.sensor_error.is_none() && ctl.output().fault.is_none());
         let c1 = control_cycle(&mut ctl, 1, &mut dev);
         assert_eq!(c1.sensor_error, Some(ErrorKind::Corrupted));
-        assert_eq!(c1.output.fault, Some(Fault::Sensor(Sensor::Missing)));
-        assert_eq!(c1.output.health, Health::Degraded);
-        assert_eq!(reel.last, Some(c1.output.rate_cmd_mps));
+        let o = ctl.output();
+        assert_eq!((o.tick, o.fault), (1, Some(Fault::Sensor(Sensor::Missing))));
+        assert_eq!(o.health, Health::Degraded);
+        assert_eq!(reel.last, Some(o.rate_cmd_mps));
     }
 }

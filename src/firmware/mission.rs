@@ -174,7 +174,6 @@ impl Mission {
         }
 
         let cycle = control_cycle(&mut self.controller, tick, &mut self.devices);
-        let o = &cycle.output;
         if let Some(e) = cycle.reel_error {
             defmt::error!("t={=u32} reel refused the command: {}", tick, e);
             return Flow::Failed;
@@ -187,6 +186,7 @@ impl Mission {
             events = true;
         }
         if events || tick.is_multiple_of(LOG_EVERY_TICKS) {
+            let o = self.controller.output();
             defmt::info!(
                 "t={=u32} {} {}: l={=f32} m alpha_ref={=f32} rad delta={=f32} rad cmd={=f32} m/s accel={=f32} m/s2 E={=f32} flags={=u32:#x}",
                 tick,
