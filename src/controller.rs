@@ -23,7 +23,7 @@
 //! Time is an integer tick count (one tick = one control period); the controller never
 //! accumulates time in floating point.
 
-use crate::envelope::Saturation;
+use crate::envelope::{PreparedEnvelope, Saturation};
 use crate::equilibrium::ExistenceMonitor;
 use crate::law::{self, Blend, LawFault, LawInput};
 use crate::monitor::{Monitor, SPOOL_MARGIN};
@@ -332,6 +332,8 @@ pub struct Controller<T: Real> {
 struct Derived<T> {
     /// The longest plausible length: the spool end plus [`SPOOL_MARGIN`], m.
     spool_m: T,
+    /// The envelope, its guarded length limits and 2a worked out.
+    envelope: PreparedEnvelope<T>,
     /// The Eq. 34 (stage 1) and Eq. 35 (stage 2) schedules, their quintics' coefficients
     /// computed.
     bands: [PreparedBand<T>; 2],
@@ -354,6 +356,7 @@ impl<T: Real> Derived<T> {
         let log2_decay = |c: T| T::from_f64(-c.to_f64() * dt * core::f64::consts::LOG2_E);
         Self {
             spool_m: T::from_f64(cfg.envelope.max_length_m.to_f64() * (1.0 + SPOOL_MARGIN)),
+            envelope: PreparedEnvelope::new(cfg.envelope),
             bands: [cfg.stage1.schedule.prepare(), cfg.stage2.schedule.prepare()],
             log2_decay_per_tick: [
                 log2_decay(cfg.stage1.decay_rate_per_s),
@@ -630,7 +633,7 @@ impl<T: Real> Controller<T> {
 
         // The first step has no previous period: the envelope judges it over one period.
         let limit_s = if elapsed_ticks == 0 { dt } else { elapsed_s };
-        let (rate, sat) = self.cfg.envelope.limit_request(
+        let (rate, sat) = self.derived.envelope.limit_request(
             law.rate_mps,
             self.last_rate_cmd_mps,
             x.length_m,
@@ -825,10 +828,10 @@ impl<T: Real> Controller<T> {
         } else {
             T::ZERO
         };
-        let (rate, sat) = self
-            .cfg
-            .envelope
-            .limit_request(target, prev, self.length_estimate_m, dt);
+        let (rate, sat) =
+            self.derived
+                .envelope
+                .limit_request(target, prev, self.length_estimate_m, dt);
         flags.set(sat.0 & Flags::LENGTH_LIMITED);
         self.last_rate_cmd_mps = rate;
         let mu3 = self.mu3_and_slope(self.length_estimate_m).0;

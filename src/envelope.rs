@@ -88,10 +88,49 @@ impl<T: Real> Envelope<T> {
         } else {
             requested_mps
         };
-        self.limit_request(requested_mps, previous_mps, length_m, dt_s)
+        PreparedEnvelope::new(*self).limit_request(requested_mps, previous_mps, length_m, dt_s)
     }
 
-    /// [`limit`](Self::limit) for a request that is not NaN: the controller's (the law's
+    /// The largest speed toward a limit `room_m` away from which the reel can still stop at
+    /// it, decelerating by at most a·Δt per period (see the module docs).
+    #[inline(never)]
+    fn braking_speed(&self, room_m: T, dt_s: T) -> T {
+        let half = T::from_f64(0.5);
+        let dv = self.max_accel_mps2 * dt_s;
+        let m = ((T::from_f64(0.25) + T::from_f64(2.0) * room_m / (dv * dt_s)).sqrt() - half)
+            .max(T::ZERO)
+            .floor();
+        // Rounding can leave v a hair above (m+1)·aΔt; the next m covers it.
+        (room_m / dt_s + dv * m * (m + T::ONE) * half) / (m + T::ONE)
+    }
+}
+
+/// An [`Envelope`] with the numbers every command needs worked out once (the controller keeps
+/// one): 2a, and each length limit less its guard, each rounded once exactly as
+/// [`Envelope::limit`] would form it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct PreparedEnvelope<T> {
+    env: Envelope<T>,
+    /// 2a, m/s².
+    two_accel_mps2: T,
+    /// The spool limit less its guard, m.
+    spool_guarded_m: T,
+    /// The docking limit plus its guard, m.
+    dock_guarded_m: T,
+}
+
+impl<T: Real> PreparedEnvelope<T> {
+    pub(crate) fn new(env: Envelope<T>) -> Self {
+        let guard = T::from_f64(LENGTH_GUARD_REL);
+        Self {
+            env,
+            two_accel_mps2: T::from_f64(2.0) * env.max_accel_mps2,
+            spool_guarded_m: env.max_length_m * (T::ONE - guard),
+            dock_guarded_m: env.min_length_m * (T::ONE + guard),
+        }
+    }
+
+    /// [`Envelope::limit`] for a request that is not NaN: the controller's (the law's
     /// solution is checked finite, a safe action asks for the previous command or zero), so the
     /// step does not test it again.
     #[inline(always)]
@@ -102,14 +141,15 @@ impl<T: Real> Envelope<T> {
         length_m: T,
         dt_s: T,
     ) -> (T, Saturation) {
+        let env = &self.env;
         let mut sat = Saturation::default();
-        let vmax = self.max_rate_mps;
+        let vmax = env.max_rate_mps;
         let mut y = requested_mps;
         if y.abs() > vmax {
             sat.0 |= Saturation::RATE;
             y = y.clamp_to(-vmax, vmax);
         }
-        let dv = self.max_accel_mps2 * dt_s;
+        let dv = env.max_accel_mps2 * dt_s;
         if (y - previous_mps).abs() > dv {
             sat.0 |= Saturation::ACCEL;
             y = y.clamp_to(previous_mps - dv, previous_mps + dv);
@@ -118,21 +158,20 @@ impl<T: Real> Envelope<T> {
         // docking when winding in. Far from it (the braking distance at y, plus two periods,
         // fits in the room left) the command passes as it is. (A negative room, past the
         // limit, is never far for a speed toward it; the braking curve sees it as zero.)
-        let guard = T::from_f64(LENGTH_GUARD_REL);
         let two = T::from_f64(2.0);
-        let far = |v: T, room: T| v * (v / (two * self.max_accel_mps2) + two * dt_s) <= room;
+        let far = |v: T, room: T| v * (v / self.two_accel_mps2 + two * dt_s) <= room;
         let (up, down) = if y > T::ZERO {
-            let up_room = self.max_length_m * (T::ONE - guard) - length_m;
+            let up_room = self.spool_guarded_m - length_m;
             if far(y, up_room) {
                 return (Self::settle(y, vmax, sat), sat);
             }
-            (self.braking_speed(up_room.max(T::ZERO), dt_s), -vmax)
+            (env.braking_speed(up_room.max(T::ZERO), dt_s), -vmax)
         } else if y < T::ZERO {
-            let down_room = length_m - self.min_length_m * (T::ONE + guard);
+            let down_room = length_m - self.dock_guarded_m;
             if far(-y, down_room) {
                 return (Self::settle(y, vmax, sat), sat);
             }
-            (vmax, -self.braking_speed(down_room.max(T::ZERO), dt_s))
+            (vmax, -env.braking_speed(down_room.max(T::ZERO), dt_s))
         } else {
             // Zero (or NaN, when `previous_mps` is: the documented fallback is −vmax).
             return (y.clamp_to(-vmax, vmax), sat);
@@ -140,7 +179,7 @@ impl<T: Real> Envelope<T> {
         if y > up || y < down {
             sat.0 |= Saturation::LENGTH;
             y = y.clamp_to(down, up);
-            let guard_m = self.max_length_m * guard;
+            let guard_m = env.max_length_m * T::from_f64(LENGTH_GUARD_REL);
             let (lo, hi) = (previous_mps - dv, previous_mps + dv);
             if y < lo && (lo - y) * dt_s <= guard_m {
                 y = lo;
@@ -160,19 +199,6 @@ impl<T: Real> Envelope<T> {
         } else {
             y
         }
-    }
-
-    /// The largest speed toward a limit `room_m` away from which the reel can still stop at
-    /// it, decelerating by at most a·Δt per period (see the module docs).
-    #[inline(never)]
-    fn braking_speed(&self, room_m: T, dt_s: T) -> T {
-        let half = T::from_f64(0.5);
-        let dv = self.max_accel_mps2 * dt_s;
-        let m = ((T::from_f64(0.25) + T::from_f64(2.0) * room_m / (dv * dt_s)).sqrt() - half)
-            .max(T::ZERO)
-            .floor();
-        // Rounding can leave v a hair above (m+1)·aΔt; the next m covers it.
-        (room_m / dt_s + dv * m * (m + T::ONE) * half) / (m + T::ONE)
     }
 }
 
