@@ -7,7 +7,7 @@
 
 use crate::config::{positive, ConfigError, Rule};
 use crate::controller::Input;
-use crate::real::{PositiveInterval, Real};
+use crate::real::{MagnitudeBound, PositiveInterval, Real};
 
 /// Which sensed value was rejected, and why.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -119,6 +119,10 @@ pub(crate) struct Monitor<T: Real> {
     length_m: PositiveInterval<T>,
     /// [min, max] orbit rate.
     orbit_rate_radps: PositiveInterval<T>,
+    /// |α| ≤ π.
+    alpha_rad: MagnitudeBound<T>,
+    /// |α̇| ≤ the configured maximum.
+    alpha_rate_radps: MagnitudeBound<T>,
     last: Accepted<T>,
     /// Bits of the last α reading and how often it repeated (NaN's bits before the first
     /// reading: an accepted α is never NaN, so the first reading is always fresh).
@@ -149,9 +153,21 @@ impl<T: Real> Monitor<T> {
                     Rule::BandInverted,
                 ),
             )?;
+        // (π always makes a bound; a validated configuration's α̇ limit does too.)
+        let pi = T::from_f64(core::f64::consts::PI);
+        let alpha_rad =
+            MagnitudeBound::new(pi).ok_or(ConfigError::new("π", pi, Rule::NotFinite))?;
+        let max_rate = cfg.max_alpha_rate_radps;
+        let alpha_rate_radps = MagnitudeBound::new(max_rate).ok_or(ConfigError::new(
+            "monitor.max_alpha_rate_radps",
+            max_rate,
+            Rule::NotPositive,
+        ))?;
         Ok(Self {
             length_m,
             orbit_rate_radps,
+            alpha_rad,
+            alpha_rate_radps,
             last: Accepted {
                 tick: 0,
                 alpha_rad: T::from_f64(f64::NAN),
@@ -168,9 +184,9 @@ impl<T: Real> Monitor<T> {
     /// sample whose tick is before the last accepted one (it rejects a tick that goes
     /// backwards first).
     ///
-    /// Each range check is one comparison that NaN and ±∞ fail (see [`PositiveInterval`]; for
-    /// the angles, every comparison with NaN is false and the bounds are finite), so "finite
-    /// and in range" costs no separate finiteness test.
+    /// Each range check is one unsigned comparison of bit patterns that NaN and ±∞ fail (see
+    /// [`PositiveInterval`] and [`MagnitudeBound`]), so "finite and in range" costs no separate
+    /// finiteness test.
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(range)` is meant: it is true for NaN.
     pub(crate) fn check(
         &mut self,
@@ -179,14 +195,13 @@ impl<T: Real> Monitor<T> {
         expected_length_m: Option<T>,
         period_s: T,
     ) -> Result<(), Sensor> {
-        let pi = T::from_f64(core::f64::consts::PI);
         if !self.length_m.contains(x.length_m) {
             return Err(Sensor::Length);
         }
-        if !(x.alpha_rad.abs() <= pi) {
+        if !self.alpha_rad.contains(x.alpha_rad) {
             return Err(Sensor::Alpha);
         }
-        if !(x.alpha_rate_radps.abs() <= cfg.max_alpha_rate_radps) {
+        if !self.alpha_rate_radps.contains(x.alpha_rate_radps) {
             return Err(Sensor::AlphaRate);
         }
         if !self.orbit_rate_radps.contains(x.orbit_rate_radps) {

@@ -68,6 +68,9 @@ pub trait Real:
     /// `self.bits() − base`, wrapping (the offset of this pattern from `base`'s; see
     /// [`PositiveInterval`]).
     fn bits_above(self, base: Self::Bits) -> Self::Bits;
+    /// The bit pattern shifted left by one: the sign dropped, the rest in the order of |x|
+    /// (see [`MagnitudeBound`]).
+    fn magnitude_bits(self) -> Self::Bits;
 
     /// The smaller of two values (the non-NaN one if one is NaN).
     #[inline]
@@ -193,6 +196,10 @@ impl Real for f32 {
     fn bits_above(self, base: u32) -> u32 {
         self.to_bits().wrapping_sub(base)
     }
+    #[inline]
+    fn magnitude_bits(self) -> u32 {
+        self.to_bits() << 1
+    }
 }
 
 impl Real for f64 {
@@ -266,6 +273,10 @@ impl Real for f64 {
     fn bits_above(self, base: u64) -> u64 {
         self.to_bits().wrapping_sub(base)
     }
+    #[inline]
+    fn magnitude_bits(self) -> u64 {
+        self.to_bits() << 1
+    }
 }
 
 /// A closed interval [lo, hi] of positive finite numbers, tested by one unsigned comparison
@@ -300,9 +311,75 @@ impl<T: Real> PositiveInterval<T> {
     }
 }
 
+/// |x| ≤ max as one unsigned comparison of bit patterns: without the sign bit, the patterns
+/// of the non-negative floats are in the order of their values, and those of ±∞ and NaN lie
+/// above every finite one, so NaN and the infinities fail it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MagnitudeBound<T: Real> {
+    max_bits: T::Bits,
+}
+
+impl<T: Real> MagnitudeBound<T> {
+    /// |x| ≤ `max`, or `None` unless 0 ≤ max < ∞.
+    pub fn new(max: T) -> Option<Self> {
+        if !(max >= T::ZERO && max.is_finite()) {
+            return None;
+        }
+        Some(Self {
+            max_bits: max.magnitude_bits(),
+        })
+    }
+
+    /// `true` if |x| ≤ max (never for NaN or an infinity).
+    #[inline(always)]
+    pub fn contains(self, x: T) -> bool {
+        x.magnitude_bits() <= self.max_bits
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use super::{PositiveInterval, Real};
+    use super::{MagnitudeBound, PositiveInterval, Real};
+
+    #[test]
+    fn magnitude_bound_is_the_float_check() {
+        let pi = core::f32::consts::PI;
+        let b = MagnitudeBound::new(pi).unwrap();
+        let check = |x: f32| assert_eq!(b.contains(x), x.abs() <= pi, "{x:e}");
+        for x in [
+            0.0,
+            -0.0,
+            pi,
+            -pi,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            -f32::NAN,
+        ] {
+            check(x);
+        }
+        check(f32::from_bits(pi.to_bits() + 1));
+        check(-f32::from_bits(pi.to_bits() + 1));
+        // Every 4099th pattern, both signs.
+        for bits in (0..=u32::MAX).step_by(4099) {
+            check(f32::from_bits(bits));
+        }
+        let b64 = MagnitudeBound::new(0.06_f64).unwrap();
+        for x in [
+            0.06,
+            -0.06,
+            0.060_000_000_1,
+            -1e300,
+            f64::NAN,
+            f64::NEG_INFINITY,
+            1e-300,
+        ] {
+            assert_eq!(b64.contains(x), x.abs() <= 0.06, "{x:e}");
+        }
+        assert!(MagnitudeBound::new(-1.0_f32).is_none());
+        assert!(MagnitudeBound::new(f32::NAN).is_none());
+        assert!(MagnitudeBound::new(f32::INFINITY).is_none());
+    }
 
     #[test]
     fn positive_interval_is_the_float_range_check() {
