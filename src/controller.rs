@@ -275,6 +275,15 @@ impl EventRing {
     }
 }
 
+/// The acceleration of a command that a limit shaped: its change over the period. Out of line
+/// and cold: a limit seldom acts, and the common step then keeps the law's Eq. 30 value
+/// without computing this.
+#[cold]
+#[inline(never)]
+fn ramp_slope<T: Real>(rate_mps: T, previous_mps: T, period_s: T) -> T {
+    (rate_mps - previous_mps) / period_s
+}
+
 /// Bound on the reported [`Output::equilibrium_margin`] (x grows as 1/l toward docking).
 pub const MAX_REPORTED_MARGIN: f64 = 1e6;
 
@@ -643,7 +652,7 @@ impl<T: Real> Controller<T> {
         flags.set(sat.0);
         flags.set_if(law.reference.slewing, Flags::SLEWING);
         let accel = if limited {
-            (rate - self.last_rate_cmd_mps) / limit_s
+            ramp_slope(rate, self.last_rate_cmd_mps, limit_s)
         } else {
             law.accel_mps2
         };
