@@ -30,7 +30,9 @@
 //! range); elsewhere, libm's answer. [`exp2_and_complement`] is the same for 2^t on
 //! −126 ≤ t ≤ −0, where the reduction is exact (r = (t − round t)·ln 2): the Eq. 29 blend
 //! weight E = e^{−cτ} = 2^{(−cΔt·log₂e)·k} and 1 − E, once per step, with −cΔt·log₂e prepared
-//! once per stage.
+//! once per stage. Outside that range it does without libm too (the same kernel, scaled; within
+//! two ulps up to overflow and for subnormal results, tested), so the firmware links neither
+//! `exp2f` nor `expm1f`.
 //!
 //! Rounding to an integer uses the classic `(v + 1.5·2²³) − 1.5·2²³`, which the FPU rounds to
 //! nearest-even exactly as `rintf` does for |v| < 2²² (LLVM keeps the pair: no fast-math).
