@@ -30,11 +30,11 @@ pub struct Stage2Config<T> {
     pub slew_rate_radps: T,
     /// c of Eq. 29 in stage 2, 1/s.
     pub decay_rate_per_s: T,
-    /// Tick at which stage 2 starts by itself; `None` waits for [`Controller::start_stage2`].
+    /// Tick at which stage 2 starts by itself; `None` waits for [`Controller::start_stage2`](crate::controller::Controller::start_stage2).
     pub start_tick: Option<u32>,
 }
 
-/// Everything that defines a controller. Validated once by [`Controller::new`].
+/// Everything that defines a controller. Validated once by [`Controller::new`](crate::controller::Controller::new).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Config<T> {
     /// Control period, s (one tick).

@@ -224,7 +224,7 @@ pub fn exp_and_complement(x: f32) -> (f32, f32) {
 /// reduction needs no two-part ln 2: the fraction t − round(t) is exact.
 ///
 /// The fast path is [`EXP2_FAST_MIN`] ≤ t ≤ −0 (one unsigned comparison of the bit pattern);
-/// everything else takes [`exp2_special`] (out of line, without libm).
+/// everything else takes an out-of-line path without libm (`exp2_special`).
 #[inline]
 pub fn exp2_and_complement(t: f32) -> (f32, f32) {
     const NEG_ZERO: u32 = 0x8000_0000;
