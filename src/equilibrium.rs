@@ -484,8 +484,8 @@ impl<T: Real> ExistenceMonitor<T> {
         normalised_rate(mu3, length_rate_mps / length_m, self.mean_motion_radps)
     }
 
-    /// [`normalised_rate`](Self::normalised_rate) from the reduced length L′ = l/(2 + μ3)
-    /// (m) the law has already formed: x = l̇/(ω L′).
+    /// [`normalised_rate`](Self::normalised_rate) (Eq. 7's x) from the reduced length
+    /// L′ = l/(2 + μ3) (m) the law has already formed: x = l̇/(ω L′), l̇ in m/s, ω in rad/s.
     #[inline(always)]
     pub fn normalised_rate_at_reduced_length(&self, reduced_length_m: T, length_rate_mps: T) -> T {
         length_rate_mps / (reduced_length_m * self.mean_motion_radps)
@@ -677,6 +677,19 @@ mod tests {
         ] {
             assert!(m.whole_orbit_margin(0.0, l, rate).is_none());
             assert!(m.check_rate(Anomaly::WholeOrbit, 0.0, l, rate).is_err());
+        }
+    }
+
+    #[test]
+    fn normalised_rate_from_the_reduced_length_is_eq_7s() {
+        let m = ExistenceMonitor::new(0.0_f64, 1.06e-3).unwrap();
+        for &(mu3, l, rate) in &[(0.0, 1.0, 0.1), (0.05, 12_000.0, 3.0), (0.2, 5.0, -12.0)] {
+            let x = m.normalised_rate(mu3, l, rate);
+            let from_reduced = m.normalised_rate_at_reduced_length(l / (2.0 + mu3), rate);
+            assert!(
+                (from_reduced - x).abs() <= 4.0 * f64::EPSILON * x.abs(),
+                "{x} vs {from_reduced}"
+            );
         }
     }
 }

@@ -187,7 +187,6 @@ impl<T: Real> Monitor<T> {
     /// Each range check is one unsigned comparison of bit patterns that NaN and ±∞ fail (see
     /// [`PositiveInterval`] and [`MagnitudeBound`]), so "finite and in range" costs no separate
     /// finiteness test.
-    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(range)` is meant: it is true for NaN.
     pub(crate) fn check(
         &mut self,
         cfg: &MonitorConfig<T>,
