@@ -445,10 +445,12 @@ mod bench {
             let mut copies: [Controller<f32>; K] = core::array::from_fn(|_| ctl.clone());
             let cost = match &input {
                 Some(x) => m.per_call(&mut copies, |c| {
-                    black_box(c.step(black_box(x)));
+                    let out = c.step(black_box(x));
+                    black_box(&out);
                 }),
                 None => m.per_call(&mut copies, |c| {
-                    black_box(c.step_missing(black_box(tick)));
+                    let out = c.step_missing(black_box(tick));
+                    black_box(&out);
                 }),
             };
             let out = match &input {
@@ -467,7 +469,7 @@ mod bench {
                     previous_rate = out.rate_cmd_mps;
                     continue;
                 }
-                let parts = time_parts(m, &cfg, &existence, &bands, x, out, previous_rate);
+                let parts = time_parts(m, &cfg, &existence, &bands, x, &out, previous_rate);
                 let mut sum = 0;
                 for (s, &v) in r.parts.iter_mut().zip(&parts) {
                     s.add(v, tick);

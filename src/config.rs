@@ -7,10 +7,72 @@
 use crate::envelope::Envelope;
 use crate::law::Gains;
 use crate::mass::MassModel;
-use crate::monitor::MonitorConfig;
 use crate::orbit::Orbit;
 use crate::real::Real;
 use crate::schedule::BandSchedule;
+
+/// Thresholds of the sensor checks and the fault timing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MonitorConfig<T> {
+    /// Ticks without a valid sample (or with a law fault) during which the controller coasts
+    /// before it goes to safe hold.
+    pub coast_ticks: u32,
+    /// Consecutive valid samples needed to leave safe hold.
+    pub recovery_ticks: u32,
+    /// Largest accepted |sensed − predicted| length, m (the prediction integrates the
+    /// command; a reel with lag drifts from it by about lag × rate change per tick).
+    pub length_jump_m: T,
+    /// Largest accepted |α − (α_prev + α̇_prev Δt)| per tick, rad.
+    pub alpha_jump_rad: T,
+    /// Identical α readings in a row, with α̇ implying motion, that make a stuck sensor.
+    pub stuck_ticks: u32,
+    /// Motion (∫|α̇|dt over the identical readings) that a stuck verdict needs, rad.
+    pub stuck_motion_rad: T,
+    /// Largest plausible |α̇|, rad/s.
+    pub max_alpha_rate_radps: T,
+    /// Smallest plausible orbit rate, rad/s.
+    pub min_orbit_rate_radps: T,
+    /// Largest plausible orbit rate, rad/s.
+    pub max_orbit_rate_radps: T,
+}
+
+impl<T: Real> MonitorConfig<T> {
+    /// Defaults for a 1 s control period: coast 30 s, recover after 10 good samples, 20 m
+    /// length jumps (an 11.8 m/s rate step through a 1 s reel lag is about 12 m), 0.1 rad angle
+    /// jumps (the paper's |α̇| stays below 1e-3 rad/s), stuck after 20 identical readings
+    /// spanning 1 mrad of implied motion, |α̇| ≤ 0.06 rad/s (≈ 60 n), 1e-5 ≤ n ≤ 0.01 rad/s
+    /// (orbit periods from 10 minutes to a week; LEO is ≈ 1.1e-3).
+    pub fn default_for_period() -> Self {
+        Self {
+            coast_ticks: 30,
+            recovery_ticks: 10,
+            length_jump_m: T::from_f64(20.0),
+            alpha_jump_rad: T::from_f64(0.1),
+            stuck_ticks: 20,
+            stuck_motion_rad: T::from_f64(1e-3),
+            max_alpha_rate_radps: T::from_f64(0.06),
+            min_orbit_rate_radps: T::from_f64(1e-5),
+            max_orbit_rate_radps: T::from_f64(0.01),
+        }
+    }
+
+    /// Checks the thresholds.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        positive("monitor.coast_ticks", T::from_u32(self.coast_ticks))?;
+        positive("monitor.recovery_ticks", T::from_u32(self.recovery_ticks))?;
+        positive("monitor.length_jump_m", self.length_jump_m)?;
+        positive("monitor.alpha_jump_rad", self.alpha_jump_rad)?;
+        positive("monitor.stuck_ticks", T::from_u32(self.stuck_ticks))?;
+        positive("monitor.stuck_motion_rad", self.stuck_motion_rad)?;
+        positive("monitor.max_alpha_rate_radps", self.max_alpha_rate_radps)?;
+        positive("monitor.min_orbit_rate_radps", self.min_orbit_rate_radps)?;
+        above(
+            "monitor.max_orbit_rate_radps",
+            self.max_orbit_rate_radps,
+            self.min_orbit_rate_radps,
+        )
+    }
+}
 
 /// Stage 1 (Eq. 34): deploy, then keep.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -93,7 +93,6 @@ impl<T: Real> Envelope<T> {
 
     /// The largest speed toward a limit `room_m` away from which the reel can still stop at
     /// it, decelerating by at most a·Δt per period (see the module docs).
-    #[inline(never)]
     fn braking_speed(&self, room_m: T, dt_s: T) -> T {
         let half = T::from_f64(0.5);
         let dv = self.max_accel_mps2 * dt_s;
@@ -133,6 +132,8 @@ impl<T: Real> PreparedEnvelope<T> {
     /// [`Envelope::limit`] for a request that is not NaN: the controller's (the law's
     /// solution is checked finite, a safe action asks for the previous command or zero), so the
     /// step does not test it again.
+    // Inlined into the step: 13 instructions less on a nominal step
+    // (tools/trace_profile.py, replay tick 301: 664 → 651).
     #[inline(always)]
     pub(crate) fn limit_request(
         &self,
@@ -192,7 +193,6 @@ impl<T: Real> PreparedEnvelope<T> {
 
     /// The command when no length limit acts: `y` is already within ±`vmax` unless the
     /// acceleration clamp moved it (toward a `previous_mps` that could lie outside).
-    #[inline(always)]
     fn settle(y: T, vmax: T, sat: Saturation) -> T {
         if sat.accel() {
             y.clamp_finite(-vmax, vmax)

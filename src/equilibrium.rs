@@ -479,14 +479,14 @@ impl<T: Real> ExistenceMonitor<T> {
 
     /// x = (2 + μ3) l̇/(ω l) (Eq. 7's normalised rate) of a reel at length `length_m` (m)
     /// running at `length_rate_mps` (m/s), with this orbit's ω. Not finite when l = 0.
-    #[inline(always)]
+    #[inline]
     pub fn normalised_rate(&self, mu3: T, length_m: T, length_rate_mps: T) -> T {
         normalised_rate(mu3, length_rate_mps / length_m, self.mean_motion_radps)
     }
 
     /// [`normalised_rate`](Self::normalised_rate) (Eq. 7's x) from the reduced length
     /// L′ = l/(2 + μ3) (m) the law has already formed: x = l̇/(ω L′), l̇ in m/s, ω in rad/s.
-    #[inline(always)]
+    #[inline]
     pub fn normalised_rate_at_reduced_length(&self, reduced_length_m: T, length_rate_mps: T) -> T {
         length_rate_mps / (reduced_length_m * self.mean_motion_radps)
     }
@@ -498,7 +498,7 @@ impl<T: Real> ExistenceMonitor<T> {
     /// The region is symmetric (max Retr = −min Depl exactly, see [`extent`]), so the margin is
     /// min Depl − |x|: bit for bit the same number (min Depl − x for x ≥ 0, x + min Depl for
     /// x < 0), without a comparison.
-    #[inline(always)]
+    #[inline]
     pub fn whole_orbit_margin_of(&self, x: T) -> T {
         self.extent.min_depl.value - x.abs()
     }

@@ -163,7 +163,7 @@ where
         Ok(input) => (controller.step(&input), None),
         Err(kind) => (controller.step_missing(tick), Some(kind)),
     };
-    let reel_error = dev.reel.command(output).err().map(|e| e.kind());
+    let reel_error = dev.reel.command(&output).err().map(|e| e.kind());
     Cycle {
         sensor_error,
         reel_error,

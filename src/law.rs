@@ -57,7 +57,6 @@ pub struct Blend<T> {
 
 impl<T: Real> Blend<T> {
     /// The blend τ after its start for the decay rate c: `neg_c_tau` = −cτ ≤ 0.
-    #[inline(always)]
     pub fn decayed(neg_c_tau: T) -> Self {
         let (weight, complement) = neg_c_tau.exp_and_complement();
         Self { weight, complement }
@@ -66,7 +65,7 @@ impl<T: Real> Blend<T> {
     /// The blend whose weight is E = 2^`log2_weight`: τ after its start for the decay rate c,
     /// `log2_weight` = −cτ·log₂e ≤ 0 (the same E as [`Blend::decayed`], with log₂e folded into
     /// the caller's constant −cΔt·log₂e; see [`crate::fastmath::exp2_and_complement`]).
-    #[inline(always)]
+    #[inline]
     pub fn from_log2(log2_weight: T) -> Self {
         let (weight, complement) = log2_weight.exp2_and_complement();
         Self { weight, complement }
@@ -221,6 +220,50 @@ pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
     })
 }
 
+/// Eq. 27 evaluated explicitly for a given δ̇ (rad/s), in the paper's form:
+///
+/// ```text
+///   l̇ = [k1 δ̇ + k2 δ − 1.5 n² sin(2δ + 2α_r)] / (n + δ̇) · l/(2 + μ3),   δ = α − α_r.
+/// ```
+///
+/// Not used by the controller (see [`solve`]): it is the oracle the implicit solve is tested
+/// against. With δ̇ = α̇ − (p·y + r) for [`solve`]'s command y, Eq. 29 on this value gives y
+/// back: y = l̇ + (l̇0 − l̇)·E.
+///
+/// ```
+/// use tss_reel::law::{explicit_eq27, solve, Blend, Gains, LawInput};
+///
+/// let x = LawInput::<f64> {
+///     length_m: 15_000.0,
+///     alpha_rad: -0.6,
+///     alpha_rate_radps: 1.0e-4,
+///     orbit_rate_radps: 1.06e-3,
+///     ref_angle_rad: -0.55,
+///     ref_slope_rad_per_m: 6.0e-5,
+///     ref_curvature_rad_per_m2: 3.0e-9,
+///     ref_time_rate_radps: 0.0,
+///     mu3: 0.0,
+///     mu3_per_m: 0.0,
+///     blend: Blend::from_weight(0.2),
+///     decay_rate_per_s: 1e-3,
+///     initial_rate_mps: 0.1,
+///     gains: Gains::paper(),
+/// };
+/// let y = solve(&x).unwrap().rate_mps;
+/// let l_dot = explicit_eq27(&x, x.alpha_rate_radps - x.ref_slope_rad_per_m * y);
+/// assert!((l_dot + (x.initial_rate_mps - l_dot) * x.blend.weight - y).abs() < 1e-12);
+/// ```
+pub fn explicit_eq27<T: Real>(x: &LawInput<T>, delta_rate_radps: T) -> T {
+    let two = T::from_f64(2.0);
+    let delta = x.alpha_rad - x.ref_angle_rad;
+    let n = x.orbit_rate_radps;
+    (x.gains.k1_per_s * delta_rate_radps + x.gains.k2_per_s2 * delta
+        - T::from_f64(1.5) * n * n * (two * delta + two * x.ref_angle_rad).sin())
+        / (n + delta_rate_radps)
+        * x.length_m
+        / (two + x.mu3)
+}
+
 /// The commanded reel acceleration ÿ = d(l̇_real)/dt, the time derivative of Eq. 29 with
 /// Eq. 27 inside it (Eq. 30, with the sign of its `[(1−e^{−cτ}) l̇_real + c l e^{−cτ}] l̇/l`
 /// term corrected, SPEC §9.3).
@@ -287,15 +330,9 @@ mod tests {
         }
     }
 
-    /// Eq. 27 evaluated directly, for a given δ̇.
+    /// Eq. 27 evaluated directly, for a given δ̇ (the shared oracle).
     fn eq27(x: &LawInput<f64>, delta_rate: f64) -> f64 {
-        let delta = x.alpha_rad - x.ref_angle_rad;
-        let n = x.orbit_rate_radps;
-        (x.gains.k1_per_s * delta_rate + x.gains.k2_per_s2 * delta
-            - 1.5 * n * n * (2.0 * delta + 2.0 * x.ref_angle_rad).sin())
-            / (n + delta_rate)
-            * x.length_m
-            / (2.0 + x.mu3)
+        explicit_eq27(x, delta_rate)
     }
 
     #[test]

@@ -73,18 +73,11 @@ impl<T: Real> MassModel<T> {
 
     /// (μ3, dμ3/dl) at `length_m`: what the law needs, from one evaluation of the
     /// coefficients (both 0 for a massless tether, without any arithmetic).
-    #[inline(always)]
+    #[inline]
     pub fn mu3_and_slope(&self, length_m: T) -> (T, T) {
         if self.tether_density_kg_per_m == T::ZERO {
             return (T::ZERO, T::ZERO);
         }
-        self.mu3_and_slope_of_massive_tether(length_m)
-    }
-
-    /// [`mu3_and_slope`](Self::mu3_and_slope) for ρ > 0 (kept out of line: the massless case
-    /// inlines to one comparison).
-    #[inline(never)]
-    fn mu3_and_slope_of_massive_tether(&self, length_m: T) -> (T, T) {
         (
             self.coefficients(length_m).mu3,
             self.mu3_rate_per_s(length_m, T::ONE),

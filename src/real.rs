@@ -22,8 +22,6 @@ pub trait Real:
     + Div<Output = Self>
     + Neg<Output = Self>
 {
-    /// The unsigned integer of the same width as the float.
-    type Bits: Copy + Debug + Eq + Ord;
     /// 0.
     const ZERO: Self;
     /// 1.
@@ -62,15 +60,6 @@ pub trait Real:
     fn asin(self) -> Self;
     /// `true` unless NaN or infinite.
     fn is_finite(self) -> bool;
-    /// The IEEE bit pattern (`u32` for `f32`, `u64` for `f64`; equal patterns ⇔ identical
-    /// values).
-    fn bits(self) -> Self::Bits;
-    /// `self.bits() − base`, wrapping (the offset of this pattern from `base`'s; see
-    /// [`PositiveInterval`]).
-    fn bits_above(self, base: Self::Bits) -> Self::Bits;
-    /// The bit pattern shifted left by one: the sign dropped, the rest in the order of |x|
-    /// (see [`MagnitudeBound`]).
-    fn magnitude_bits(self) -> Self::Bits;
 
     /// The smaller of two values (the non-NaN one if one is NaN).
     #[inline]
@@ -125,7 +114,6 @@ pub trait Real:
 }
 
 impl Real for f32 {
-    type Bits = u32;
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;
     #[inline]
@@ -188,22 +176,9 @@ impl Real for f32 {
     fn is_finite(self) -> bool {
         f32::is_finite(self)
     }
-    #[inline]
-    fn bits(self) -> u32 {
-        self.to_bits()
-    }
-    #[inline]
-    fn bits_above(self, base: u32) -> u32 {
-        self.to_bits().wrapping_sub(base)
-    }
-    #[inline]
-    fn magnitude_bits(self) -> u32 {
-        self.to_bits() << 1
-    }
 }
 
 impl Real for f64 {
-    type Bits = u64;
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;
     #[inline]
@@ -265,171 +240,11 @@ impl Real for f64 {
     fn is_finite(self) -> bool {
         f64::is_finite(self)
     }
-    #[inline]
-    fn bits(self) -> u64 {
-        self.to_bits()
-    }
-    #[inline]
-    fn bits_above(self, base: u64) -> u64 {
-        self.to_bits().wrapping_sub(base)
-    }
-    #[inline]
-    fn magnitude_bits(self) -> u64 {
-        self.to_bits() << 1
-    }
-}
-
-/// A closed interval [lo, hi] of positive finite numbers, tested by one unsigned comparison
-/// of bit patterns: the non-negative floats are ordered as their patterns are, so x ∈ [lo, hi]
-/// exactly when `x.bits() − lo.bits()` (wrapping) ≤ `hi.bits() − lo.bits()`. Everything else
-/// fails that comparison by the same arithmetic: values below lo wrap around to huge offsets,
-/// and negative numbers (−0 included), +∞ and NaN have patterns above hi's. So
-/// "finite and in range" costs one integer comparison (a float range check costs two
-/// comparisons and a status-register transfer each).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct PositiveInterval<T: Real> {
-    lo_bits: T::Bits,
-    span_bits: T::Bits,
-}
-
-impl<T: Real> PositiveInterval<T> {
-    /// [lo, hi], or `None` unless 0 < lo ≤ hi < ∞.
-    pub fn new(lo: T, hi: T) -> Option<Self> {
-        if !(lo > T::ZERO && lo <= hi && hi.is_finite()) {
-            return None;
-        }
-        Some(Self {
-            lo_bits: lo.bits(),
-            span_bits: hi.bits_above(lo.bits()),
-        })
-    }
-
-    /// `true` if lo ≤ x ≤ hi (never for NaN or an infinity).
-    #[inline(always)]
-    pub fn contains(self, x: T) -> bool {
-        x.bits_above(self.lo_bits) <= self.span_bits
-    }
-}
-
-/// |x| ≤ max as one unsigned comparison of bit patterns: without the sign bit, the patterns
-/// of the non-negative floats are in the order of their values, and those of ±∞ and NaN lie
-/// above every finite one, so NaN and the infinities fail it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct MagnitudeBound<T: Real> {
-    max_bits: T::Bits,
-}
-
-impl<T: Real> MagnitudeBound<T> {
-    /// |x| ≤ `max`, or `None` unless 0 ≤ max < ∞.
-    pub fn new(max: T) -> Option<Self> {
-        if !(max >= T::ZERO && max.is_finite()) {
-            return None;
-        }
-        Some(Self {
-            max_bits: max.magnitude_bits(),
-        })
-    }
-
-    /// `true` if |x| ≤ max (never for NaN or an infinity).
-    #[inline(always)]
-    pub fn contains(self, x: T) -> bool {
-        x.magnitude_bits() <= self.max_bits
-    }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::{MagnitudeBound, PositiveInterval, Real};
-
-    #[test]
-    fn magnitude_bound_is_the_float_check() {
-        let pi = core::f32::consts::PI;
-        let b = MagnitudeBound::new(pi).unwrap();
-        let check = |x: f32| assert_eq!(b.contains(x), x.abs() <= pi, "{x:e}");
-        for x in [
-            0.0,
-            -0.0,
-            pi,
-            -pi,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::NAN,
-            -f32::NAN,
-        ] {
-            check(x);
-        }
-        check(f32::from_bits(pi.to_bits() + 1));
-        check(-f32::from_bits(pi.to_bits() + 1));
-        // Every 4099th pattern, both signs.
-        for bits in (0..=u32::MAX).step_by(4099) {
-            check(f32::from_bits(bits));
-        }
-        let b64 = MagnitudeBound::new(0.06_f64).unwrap();
-        for x in [
-            0.06,
-            -0.06,
-            0.060_000_000_1,
-            -1e300,
-            f64::NAN,
-            f64::NEG_INFINITY,
-            1e-300,
-        ] {
-            assert_eq!(b64.contains(x), x.abs() <= 0.06, "{x:e}");
-        }
-        assert!(MagnitudeBound::new(-1.0_f32).is_none());
-        assert!(MagnitudeBound::new(f32::NAN).is_none());
-        assert!(MagnitudeBound::new(f32::INFINITY).is_none());
-    }
-
-    #[test]
-    fn positive_interval_is_the_float_range_check() {
-        let r32 = PositiveInterval::new(1e-3_f32, 31_500.0).unwrap();
-        let check = |x: f32| {
-            let expected = (1e-3..=31_500.0).contains(&x);
-            assert_eq!(r32.contains(x), expected, "{x:e}");
-        };
-        for x in [
-            0.0,
-            -0.0,
-            f32::MIN_POSITIVE,
-            1e-45,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::NAN,
-            -f32::NAN,
-            f32::MAX,
-            f32::MIN,
-        ] {
-            check(x);
-        }
-        for e in [1e-3_f32, 0.5, 1.0, 31_500.0] {
-            for x in [e, e.next_up(), e.next_down(), -e] {
-                check(x);
-            }
-        }
-        // Every 4099th pattern of the whole f32 range.
-        for b in (0..=u32::MAX).step_by(4099) {
-            check(f32::from_bits(b));
-        }
-        let r64 = PositiveInterval::new(1e-5_f64, 1e-2).unwrap();
-        for x in [
-            1e-5,
-            1e-2,
-            5e-3,
-            0.0,
-            -0.0,
-            -5e-3,
-            1e-2_f64.next_up(),
-            f64::NAN,
-            f64::INFINITY,
-        ] {
-            assert_eq!(r64.contains(x), (1e-5..=1e-2).contains(&x), "{x:e}");
-        }
-        assert!(PositiveInterval::new(0.0_f32, 1.0).is_none());
-        assert!(PositiveInterval::new(2.0_f32, 1.0).is_none());
-        assert!(PositiveInterval::new(1.0_f32, f32::INFINITY).is_none());
-        assert!(PositiveInterval::new(f64::NAN, 1.0).is_none());
-    }
+    use super::Real;
 
     #[test]
     fn min_max_clamp_treat_nan_as_missing() {

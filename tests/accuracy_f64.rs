@@ -149,7 +149,7 @@ fn input_rounding(c64: &Controller<f64>, x: &Input<f64>, y64: f64) -> f64 {
     [h, -h]
         .iter()
         .map(|d| {
-            let out = *c64.clone().step(&Input {
+            let out = c64.clone().step(&Input {
                 alpha_rad: x.alpha_rad + d,
                 ..*x
             });
@@ -185,15 +185,15 @@ fn compare(ticks: u32, orbit_rate_radps: f32, sample: impl Fn(u32) -> Option<[f3
             Some(x) => {
                 let x64 = to_f64(x);
                 let before = c64.clone();
-                let o64 = *c64.step(&x64);
+                let o64 = c64.step(&x64);
                 let sens = if law_ran(&o64) {
                     input_rounding(&before, &x64, o64.rate_cmd_mps)
                 } else {
                     0.0
                 };
-                (*c32.step(x), o64, sens)
+                (c32.step(x), o64, sens)
             }
-            None => (*c32.step_missing(tick), *c64.step_missing(tick), 0.0),
+            None => (c32.step_missing(tick), c64.step_missing(tick), 0.0),
         };
         if o32.phase != o64.phase || o32.health != o64.health {
             f.state_mismatches += 1;
@@ -330,7 +330,7 @@ fn random_states_f32_vs_f64() {
         if o32.phase != o64.phase || o32.health != o64.health {
             f.state_mismatches += 1;
         }
-        if !(law_ran(o32) && law_ran(o64)) {
+        if !(law_ran(&o32) && law_ran(&o64)) {
             continue;
         }
         let y64 = o64.rate_cmd_mps;
@@ -341,7 +341,7 @@ fn random_states_f32_vs_f64() {
         if e > GOAL && e > UNEXPLAINED_FACTOR * sens {
             f.unexplained += 1;
         }
-        let dref = ref_diff(o32, o64);
+        let dref = ref_diff(&o32, &o64);
         f.max_ref_angle_diff_rad = f.max_ref_angle_diff_rad.max(dref);
         if e > f.worst.rel {
             f.worst = Worst {

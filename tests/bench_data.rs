@@ -132,7 +132,7 @@ fn interpolated_mission_flies_every_phase_nominally() {
     let mut worst = (0.0_f64, 0_u32);
     for tick in 0..mission::TICKS {
         let s = mission::sample(tick).unwrap();
-        let out = *ctl.step(&Input {
+        let out = ctl.step(&Input {
             tick,
             length_m: s[0],
             alpha_rad: s[1],

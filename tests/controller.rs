@@ -93,11 +93,11 @@ fn dropout_coasts_then_holds_then_recovers_through_the_blend() {
     let mut ctl = paper();
     let cfg = *ctl.config();
     let mut l = 2_000.0_f32;
-    let mut out = *ctl.step(&sample(0, l));
+    let mut out = ctl.step(&sample(0, l));
     // Run nominally for a while so the law's rate differs from the initial rate.
     for t in 1..600 {
         l += out.rate_cmd_mps;
-        out = *ctl.step(&sample(t, l));
+        out = ctl.step(&sample(t, l));
     }
     assert_eq!(out.health, Health::Nominal);
     let cruise = out.rate_cmd_mps;
@@ -105,7 +105,7 @@ fn dropout_coasts_then_holds_then_recovers_through_the_blend() {
 
     // Dropout: coast on the last command for coast_ticks, length predicted.
     let t0 = 600;
-    let first = *ctl.step_missing(t0);
+    let first = ctl.step_missing(t0);
     assert_eq!(first.health, Health::Degraded);
     assert_eq!(first.fault, Some(Fault::Sensor(Sensor::Missing)));
     assert!(first
@@ -116,7 +116,7 @@ fn dropout_coasts_then_holds_then_recovers_through_the_blend() {
     let coast = cfg.monitor.coast_ticks;
     let mut last = first;
     for k in 1..coast {
-        last = *ctl.step_missing(t0 + k);
+        last = ctl.step_missing(t0 + k);
         assert_eq!(last.health, Health::Degraded);
         assert_eq!(last.rate_cmd_mps, cruise);
     }
@@ -124,11 +124,11 @@ fn dropout_coasts_then_holds_then_recovers_through_the_blend() {
     let mut prev = last.rate_cmd_mps;
     let dv = cfg.envelope.max_accel_mps2 * cfg.period_s;
     let mut t = t0 + coast;
-    let hold = *ctl.step_missing(t);
+    let hold = ctl.step_missing(t);
     assert_eq!(hold.health, Health::SafeHold);
     assert!(hold.flags.contains(Flags::HEALTH_CHANGED));
     for _ in 0..100 {
-        let o = *ctl.step_missing(t);
+        let o = ctl.step_missing(t);
         assert!(o.rate_cmd_mps.abs() <= prev.abs() && (o.rate_cmd_mps - prev).abs() <= dv + 1e-6);
         prev = o.rate_cmd_mps;
         t += 1;
@@ -138,7 +138,7 @@ fn dropout_coasts_then_holds_then_recovers_through_the_blend() {
     // Recovery needs recovery_ticks good samples in a row, then the blend restarts from 0.
     let l_true = last.length_estimate_m;
     for k in 0..cfg.monitor.recovery_ticks - 1 {
-        let o = *ctl.step(&sample(t + k, l_true));
+        let o = ctl.step(&sample(t + k, l_true));
         assert_eq!(
             o.health,
             Health::SafeHold,
@@ -147,7 +147,7 @@ fn dropout_coasts_then_holds_then_recovers_through_the_blend() {
         );
         assert_eq!(o.rate_cmd_mps, 0.0);
     }
-    let back = *ctl.step(&sample(t + cfg.monitor.recovery_ticks - 1, l_true));
+    let back = ctl.step(&sample(t + cfg.monitor.recovery_ticks - 1, l_true));
     assert_eq!(back.health, Health::Nominal);
     assert!(back
         .flags
@@ -164,9 +164,9 @@ fn dropout_coasts_then_holds_then_recovers_through_the_blend() {
 fn a_short_gap_only_degrades() {
     let mut ctl = paper();
     ctl.step(&sample(0, 100.0));
-    let o = *ctl.step_missing(1);
+    let o = ctl.step_missing(1);
     assert_eq!(o.health, Health::Degraded);
-    let o = *ctl.step(&sample(2, 100.2));
+    let o = ctl.step(&sample(2, 100.2));
     assert_eq!(o.health, Health::Nominal);
     assert!(o.flags.contains(Flags::HEALTH_CHANGED) && o.fault.is_none());
 }
@@ -177,7 +177,7 @@ fn a_missing_first_sample_does_not_poison_the_length_check() {
     // (at any length) anchors it instead of failing as a jump.
     let mut ctl = paper();
     assert_eq!(ctl.step_missing(0).health, Health::Degraded);
-    let o = *ctl.step(&sample(1, 12_345.0));
+    let o = ctl.step(&sample(1, 12_345.0));
     assert_eq!(o.health, Health::Nominal, "{o:?}");
     assert_eq!(o.length_estimate_m, 12_345.0);
 }
@@ -185,11 +185,11 @@ fn a_missing_first_sample_does_not_poison_the_length_check() {
 #[test]
 fn length_glitch_is_rejected_and_the_prediction_used() {
     let mut ctl = paper();
-    let o = *ctl.step(&sample(0, 5_000.0));
-    let glitch = *ctl.step(&sample(1, 5_100.0));
+    let o = ctl.step(&sample(0, 5_000.0));
+    let glitch = ctl.step(&sample(1, 5_100.0));
     assert_eq!(glitch.fault, Some(Fault::Sensor(Sensor::LengthJump)));
     assert!((glitch.length_estimate_m - (5_000.0 + o.rate_cmd_mps)).abs() < 1e-2);
-    let ok = *ctl.step(&sample(2, 5_000.0 + 2.0 * o.rate_cmd_mps));
+    let ok = ctl.step(&sample(2, 5_000.0 + 2.0 * o.rate_cmd_mps));
     assert_eq!(ok.health, Health::Nominal);
 }
 
@@ -199,7 +199,7 @@ fn stuck_angle_sensor_is_detected() {
     let mut verdict = None;
     for t in 0..40 {
         // α frozen at −0.7 while α̇ claims 1e-4 rad/s.
-        let o = *ctl.step(&Input {
+        let o = ctl.step(&Input {
             alpha_rate_radps: 1e-4,
             ..sample(t, 100.0 + t as f32 * 0.1)
         });
@@ -262,7 +262,7 @@ fn non_finite_and_out_of_range_samples_are_typed() {
     for (input, sensor) in cases {
         let mut ctl = paper();
         ctl.step(&sample(0, 1.0));
-        let o: Output<f32> = *ctl.step(&input);
+        let o: Output<f32> = ctl.step(&input);
         assert_eq!(o.fault, Some(Fault::Sensor(sensor)), "{input:?}");
         assert!(o.rate_cmd_mps.is_finite());
     }
@@ -279,7 +279,7 @@ fn singular_law_is_a_fault_and_the_reel_coasts() {
     // α̇ = −n on the deployment plateau: n + δ̇ = 0, Eq. 27's denominator vanishes.
     let mut ctl = paper();
     ctl.step(&sample(0, 100.0));
-    let o = *ctl.step(&Input {
+    let o = ctl.step(&Input {
         alpha_rate_radps: -N_RADPS,
         ..sample(1, 100.1)
     });
@@ -299,13 +299,13 @@ fn stage2_starts_on_command_and_restarts_the_blend_from_the_current_rate() {
     };
     let mut ctl = Controller::new(cfg).unwrap();
     let mut l = 29_999.0;
-    let mut o = *ctl.step(&Input {
+    let mut o = ctl.step(&Input {
         alpha_rad: 0.0,
         ..sample(0, l)
     });
     for t in 1..100 {
         l += o.rate_cmd_mps;
-        o = *ctl.step(&Input {
+        o = ctl.step(&Input {
             alpha_rad: 0.0,
             ..sample(t, l)
         });
@@ -313,7 +313,7 @@ fn stage2_starts_on_command_and_restarts_the_blend_from_the_current_rate() {
     assert_eq!(o.phase, Phase::Keep1);
     let before = o.rate_cmd_mps;
     ctl.start_stage2();
-    let s = *ctl.step(&Input {
+    let s = ctl.step(&Input {
         alpha_rad: 0.0,
         ..sample(100, l + before)
     });
@@ -330,18 +330,18 @@ fn stage2_starts_on_command_and_restarts_the_blend_from_the_current_rate() {
 #[test]
 fn early_deployment_is_flagged_outside_the_equilibrium_region() {
     // l̇/l = 0.1 s⁻¹ at l = 1 m: x = 2·0.1/(n·1) ≈ 189 ≫ 1.5 (Eq. 13).
-    let o = *paper().step(&sample(0, 1.0));
+    let o = paper().step(&sample(0, 1.0));
     assert!(o.flags.contains(Flags::NO_EQUILIBRIUM));
     assert!(o.equilibrium_margin < -100.0);
     // Station keeping at 30 km is inside with margin ≈ 1.5.
     let mut ctl = paper();
-    let o = *ctl.step(&Input {
+    let o = ctl.step(&Input {
         alpha_rad: 0.0,
         ..sample(0, 30_000.0)
     });
     let mut o2 = o;
     for t in 1..5000 {
-        o2 = *ctl.step(&Input {
+        o2 = ctl.step(&Input {
             alpha_rad: 0.0,
             ..sample(t, 30_000.0)
         });

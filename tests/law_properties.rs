@@ -9,7 +9,7 @@
 //!   in the flight build's f32).
 
 use proptest::prelude::*;
-use tss_reel::law::{acceleration, solve, Blend, Gains, LawInput};
+use tss_reel::law::{acceleration, explicit_eq27, solve, Blend, Gains, LawInput};
 
 const N: f64 = 1.060_237_230_236_363_5e-3;
 
@@ -45,15 +45,10 @@ prop_compose! {
     }
 }
 
-/// Eq. 27 with a given δ̇.
+/// Eq. 27 with a given δ̇: the law's documented explicit form, the oracle of the implicit
+/// solve.
 fn eq27(x: &LawInput<f64>, delta_rate: f64) -> f64 {
-    let delta = x.alpha_rad - x.ref_angle_rad;
-    let n = x.orbit_rate_radps;
-    (x.gains.k1_per_s * delta_rate + x.gains.k2_per_s2 * delta
-        - 1.5 * n * n * (2.0 * delta + 2.0 * x.ref_angle_rad).sin())
-        / (n + delta_rate)
-        * x.length_m
-        / (2.0 + x.mu3)
+    explicit_eq27(x, delta_rate)
 }
 
 proptest! {

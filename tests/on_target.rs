@@ -247,7 +247,7 @@ mod tests {
         let mut tick = 0;
         for &a in &junk {
             for &b in &junk {
-                let o = *ctl.step(&Input {
+                let o = ctl.step(&Input {
                     tick,
                     length_m: a,
                     alpha_rad: b,

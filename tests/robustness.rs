@@ -124,7 +124,7 @@ proptest! {
                 Some(t) if out.tick >= t => out.tick - t,
                 _ => 1,
             };
-            assert_output_sane(out, prev_rate, elapsed, &env);
+            assert_output_sane(&out, prev_rate, elapsed, &env);
             if last_tick.is_none_or(|t| out.tick >= t) {
                 last_tick = Some(out.tick);
             }
@@ -151,7 +151,7 @@ proptest! {
         let mut alpha = alpha0;
         for (tick, (dalpha, rate)) in steps.into_iter().enumerate() {
             alpha = (alpha + dalpha).clamp(-1.5, 1.5);
-            let out = *ctl.step(&Input {
+            let out = ctl.step(&Input {
                 tick: tick as u32,
                 length_m: l as f32,
                 alpha_rad: alpha,

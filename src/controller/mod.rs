@@ -1,0 +1,419 @@
+//! The reel controller: one fixed-step [`Controller::step`] from sensed length, α, α̇ and orbit
+//! rate to a reel-rate command, through the reference schedules (Eqs. 34, 35), the implicit
+//! range-rate law (Eq. 27 + 29, SPEC §5), the commanded acceleration (Eq. 30) and the mission
+//! sequencer (SPEC §7).
+//!
+//! ```
+//! use tss_reel::controller::{Config, Controller, Input, Phase};
+//!
+//! // The paper's mission, stage 2 at t = 8 h, 1 s control period.
+//! let mut ctl = Controller::new(Config::<f32>::paper()).expect("the paper's numbers are valid");
+//! let out = ctl.step(&Input {
+//!     tick: 0,
+//!     length_m: 1.0,
+//!     alpha_rad: -35.0_f32.to_radians(),
+//!     alpha_rate_radps: 0.0,
+//!     orbit_rate_radps: 1.0602e-3,
+//! });
+//! // The output is a value: the controller can be used again while it is read.
+//! while let Some(event) = ctl.pop_event() {
+//!     assert_eq!(event.tick, 0); // the stage-1 blend started
+//! }
+//! assert_eq!(out.phase, Phase::Deploy);
+//! assert!((out.rate_cmd_mps - 0.1).abs() < 1e-6); // the blend starts from l̇0 = 0.1 m/s
+//! assert!(out.fault.is_none());
+//! assert_eq!(ctl.output(), &out);
+//! ```
+//!
+//! A step reads as the paper's loop and PX4's `PositionControl` do: check the inputs
+//! ([`crate::monitor`]) → sequence the mission (`sequencer`: stages, phases, the Eq. 29
+//! blend, α_r) → the law ([`crate::law`]) → the envelope ([`crate::envelope`]) → the output
+//! and its events. Without a usable sample the health state machine (`health`) takes a
+//! safe action on the dead-reckoned length instead of the law.
+//!
+//! Time is an integer tick count (one tick = one control period); the controller never
+//! accumulates time in floating point.
+
+mod events;
+mod health;
+mod output;
+mod sequencer;
+
+use crate::envelope::PreparedEnvelope;
+use crate::equilibrium::ExistenceMonitor;
+use crate::law::{self, LawInput};
+use crate::monitor::{Monitor, SPOOL_MARGIN};
+use crate::real::Real;
+
+pub use crate::config::{Config, ConfigError, MonitorConfig, Rule, Stage1Config, Stage2Config};
+pub use crate::envelope::Envelope;
+pub use crate::monitor::{Input, Sensor};
+pub use events::{Event, EventKind, EVENT_CAPACITY};
+pub use output::{Fault, Flags, Health, Output, Phase};
+
+use events::EventRing;
+use health::{DeadReckoning, HealthMachine};
+use sequencer::Sequencer;
+
+/// Bound on the reported [`Output::equilibrium_margin`] (x grows as 1/l toward docking).
+pub const MAX_REPORTED_MARGIN: f64 = 1e6;
+
+/// The reel controller (see the module docs for a complete example).
+#[derive(Clone, Debug)]
+pub struct Controller<T: Real> {
+    cfg: Config<T>,
+    /// The envelope, its guarded length limits worked out.
+    envelope: PreparedEnvelope<T>,
+    existence: ExistenceMonitor<T>,
+    monitor: Monitor<T>,
+    sequencer: Sequencer<T>,
+    health: HealthMachine,
+    length: DeadReckoning<T>,
+    /// The tick of the last step whose time was accepted (`None` before the first step).
+    last_tick: Option<u32>,
+    /// The command of the last step, m/s (l̇0 before the first).
+    last_rate_cmd_mps: T,
+    /// The fault of the last step (a fault is an event when it differs from the last).
+    last_fault: Option<Fault>,
+    events: EventRing,
+    /// The last step's output ([`Controller::output`]).
+    out: Output<T>,
+}
+
+impl<T: Real> Controller<T> {
+    /// Builds a controller from a validated configuration. A controller that exists is a valid
+    /// one.
+    pub fn new(cfg: Config<T>) -> Result<Self, ConfigError> {
+        cfg.validate()?;
+        let existence = ExistenceMonitor::from_orbit(&cfg.orbit).map_err(|_| {
+            ConfigError::new(
+                "orbit.eccentricity",
+                cfg.orbit.eccentricity,
+                Rule::NoEquilibrium,
+            )
+        })?;
+        // The longest plausible length: the spool end plus the monitor's margin.
+        let spool_m = T::from_f64(cfg.envelope.max_length_m.to_f64() * (1.0 + SPOOL_MARGIN));
+        Ok(Self {
+            envelope: PreparedEnvelope::new(cfg.envelope),
+            existence,
+            monitor: Monitor::new(spool_m)?,
+            sequencer: Sequencer::new(&cfg),
+            health: HealthMachine::new(),
+            length: DeadReckoning::new(spool_m),
+            last_tick: None,
+            last_rate_cmd_mps: cfg.initial_rate_mps,
+            last_fault: None,
+            events: EventRing::new(),
+            out: Output {
+                tick: 0,
+                phase: Phase::Deploy,
+                health: Health::Nominal,
+                rate_cmd_mps: T::ZERO,
+                accel_cmd_mps2: T::ZERO,
+                law_rate_mps: T::ZERO,
+                blend_weight: T::ONE,
+                alpha_ref_rad: T::ZERO,
+                alpha_ref_rate_radps: T::ZERO,
+                delta_rad: T::ZERO,
+                delta_rate_radps: T::ZERO,
+                length_estimate_m: T::ZERO,
+                equilibrium_margin: T::ZERO,
+                flags: Flags(0),
+                fault: None,
+            },
+            cfg,
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &Config<T> {
+        &self.cfg
+    }
+
+    /// The current phase.
+    pub fn phase(&self) -> Phase {
+        self.sequencer.phase()
+    }
+
+    /// The current input health.
+    pub fn health(&self) -> Health {
+        self.health.health()
+    }
+
+    /// The last step's output. Before the first step: tick 0, a zero rate and acceleration,
+    /// blend weight 1, the stage-1 phase and nominal health, no flags and no fault.
+    pub fn output(&self) -> &Output<T> {
+        &self.out
+    }
+
+    /// The oldest unread event (health and phase changes, faults, blend restarts), if any.
+    ///
+    /// The queue holds [`EVENT_CAPACITY`] events; read it every period so none are dropped
+    /// ([`Controller::events_dropped`] counts any that were).
+    pub fn pop_event(&mut self) -> Option<Event> {
+        self.events.pop()
+    }
+
+    /// Events dropped because the queue was full when they happened.
+    pub fn events_dropped(&self) -> u32 {
+        self.events.dropped()
+    }
+
+    /// Asks for stage 2 (retrieval) to begin at the next step, whatever the configured start.
+    pub fn start_stage2(&mut self) {
+        self.sequencer.request_stage2();
+    }
+
+    /// One control period with a fresh sensor sample: the command for the coming period and
+    /// what it was made of (also kept for [`Controller::output`]).
+    pub fn step(&mut self, input: &Input<T>) -> Output<T> {
+        self.run(input.tick, Some(input))
+    }
+
+    /// One control period in which no sample arrived (a sensor dropout): the controller coasts
+    /// on the predicted length, then goes to safe hold (see [`Health`]).
+    pub fn step_missing(&mut self, tick: u32) -> Output<T> {
+        self.run(tick, None)
+    }
+
+    /// A step, then its events and the kept output.
+    fn run(&mut self, tick: u32, sample: Option<&Input<T>>) -> Output<T> {
+        let (health, phase) = (self.health.health(), self.sequencer.phase());
+        let out = self.decide(tick, sample);
+        self.record_events(health, phase, &out);
+        self.out = out;
+        out
+    }
+
+    /// Check inputs → sequence the mission → law → envelope → output.
+    fn decide(&mut self, tick: u32, sample: Option<&Input<T>>) -> Output<T> {
+        let mut flags = Flags::default();
+        let dt = self.cfg.period_s;
+
+        // The time base: a tick that goes backwards is a bad sample; time does not move.
+        let elapsed_ticks = match self.last_tick {
+            None => 0,
+            Some(last) if tick >= last => tick - last,
+            Some(_) => {
+                let unmoved = self.length.length_m();
+                return self.reject(tick, unmoved, Fault::Sensor(Sensor::Tick), None, flags);
+            }
+        };
+        let first = self.last_tick.is_none();
+        self.last_tick = Some(tick);
+        let elapsed_s = T::from_u32(elapsed_ticks) * dt;
+        // Dead reckoning: the reel ran at the last command since the last step.
+        let predicted_m = self.length.predict(self.last_rate_cmd_mps, elapsed_s);
+
+        // Sequence the mission: stage 1 with the first step, stage 2 at its tick or on
+        // command, each restarting the blend (SPEC §7).
+        if first {
+            self.sequencer.begin_stage1(tick, &mut flags);
+        }
+        self.sequencer
+            .begin_stage2_if_due(tick, self.last_rate_cmd_mps, &mut flags);
+
+        // Check the inputs. Before the first accepted sample, and in safe hold, there is no
+        // trusted prediction: the next valid sample (re-)anchors it.
+        let Some(x) = sample else {
+            let missing = Fault::Sensor(Sensor::Missing);
+            return self.reject(tick, predicted_m, missing, None, flags);
+        };
+        let expected = match self.health.health() {
+            Health::SafeHold => None,
+            Health::Nominal | Health::Degraded => predicted_m,
+        };
+        if let Err(s) = self.monitor.check(&self.cfg.monitor, x, expected, dt) {
+            return self.reject(tick, predicted_m, Fault::Sensor(s), None, flags);
+        }
+        self.length.sensed(x.length_m);
+
+        let reference = self.sequencer.reference(tick, x.length_m);
+        if self.health.health() == Health::SafeHold {
+            if !self.health.recovered(&self.cfg.monitor) {
+                return self.hold(tick, reference.angle.angle_rad, None, flags);
+            }
+            // Recovered: re-engage the law through the Eq. 29 blend from the current rate.
+            self.sequencer
+                .restart_blend(tick, self.last_rate_cmd_mps, &mut flags);
+        }
+
+        // The law: Eqs. 27 + 29 solved implicitly, and the Eq. 30 acceleration.
+        let (mu3, mu3_per_m) = self.cfg.masses.mu3_and_slope(x.length_m);
+        let law_in = LawInput {
+            length_m: x.length_m,
+            alpha_rad: x.alpha_rad,
+            alpha_rate_radps: x.alpha_rate_radps,
+            orbit_rate_radps: x.orbit_rate_radps,
+            ref_angle_rad: reference.angle.angle_rad,
+            ref_slope_rad_per_m: reference.angle.slope_rad_per_m,
+            ref_curvature_rad_per_m2: reference.angle.curvature_rad_per_m2,
+            ref_time_rate_radps: reference.time_rate_radps,
+            mu3,
+            mu3_per_m,
+            blend: self.sequencer.blend(tick),
+            decay_rate_per_s: self.sequencer.blend_decay_rate_per_s(),
+            initial_rate_mps: self.sequencer.blend_initial_rate_mps(),
+            gains: self.cfg.gains,
+        };
+        let (law, accel_mps2) =
+            match law::solve(&law_in).and_then(|s| Ok((s, law::acceleration(&law_in, &s)?))) {
+                Ok(v) => v,
+                Err(f) => {
+                    let alpha_ref = Some(reference.angle.angle_rad);
+                    return self.reject(tick, Some(x.length_m), Fault::Law(f), alpha_ref, flags);
+                }
+            };
+        self.health.usable(&mut flags);
+
+        // The envelope. The first step has no previous period: it is judged over one period.
+        let limit_s = if elapsed_ticks == 0 { dt } else { elapsed_s };
+        let previous = self.last_rate_cmd_mps;
+        let (rate, sat) = self
+            .envelope
+            .limit_request(law.rate_mps, previous, x.length_m, limit_s);
+        flags.set(sat.0);
+        flags.set_if(reference.slewing, Flags::SLEWING);
+        // A limited command's acceleration is its change over the period; otherwise Eq. 30's.
+        let accel = if sat.any() {
+            (rate - previous) / limit_s
+        } else {
+            accel_mps2
+        };
+        self.last_rate_cmd_mps = rate;
+        self.sequencer.advance_phase(x.length_m, reference.slewing);
+
+        // The output.
+        let x_rate = self
+            .existence
+            .normalised_rate_at_reduced_length(law.reduced_length_m, rate);
+        let margin = self.equilibrium_margin(x_rate);
+        flags.set_if(margin < T::ZERO, Flags::NO_EQUILIBRIUM);
+        Output {
+            tick,
+            phase: self.sequencer.phase(),
+            health: self.health.health(),
+            rate_cmd_mps: rate,
+            accel_cmd_mps2: accel,
+            law_rate_mps: law.law_rate_mps,
+            blend_weight: law_in.blend.weight,
+            alpha_ref_rad: reference.angle.angle_rad,
+            alpha_ref_rate_radps: law.ref_rate_radps,
+            delta_rad: law.delta_rad,
+            delta_rate_radps: law.delta_rate_radps,
+            length_estimate_m: x.length_m,
+            equilibrium_margin: margin,
+            flags,
+            fault: None,
+        }
+    }
+
+    /// No usable sample or no law solution at this tick: the health machine counts it, and
+    /// `length_m` (the prediction, or the sensed length of a valid sample the law could not
+    /// use) becomes the length estimate. Then the safe action.
+    fn reject(
+        &mut self,
+        tick: u32,
+        length_m: Option<T>,
+        fault: Fault,
+        alpha_ref_rad: Option<T>,
+        mut flags: Flags,
+    ) -> Output<T> {
+        self.length.coast(length_m);
+        self.health.unusable(&self.cfg.monitor, &mut flags);
+        // Without a usable sample, α_r is reported at the estimated length.
+        let alpha_ref_rad = alpha_ref_rad.unwrap_or_else(|| {
+            let l = self.length.length_m().unwrap_or(T::ZERO);
+            self.sequencer.reference(tick, l).angle.angle_rad
+        });
+        self.hold(tick, alpha_ref_rad, Some(fault), flags)
+    }
+
+    /// The safe actions. Degraded: keep the last command (coast). Safe hold: ramp the rate to
+    /// zero at the acceleration limit. Both stay inside the length limits, judged on the
+    /// estimated length (before any accepted sample, on the docking end: 0 m).
+    fn hold(
+        &mut self,
+        tick: u32,
+        alpha_ref_rad: T,
+        fault: Option<Fault>,
+        mut flags: Flags,
+    ) -> Output<T> {
+        flags.set(Flags::SAFE_ACTION);
+        let dt = self.cfg.period_s;
+        let previous = self.last_rate_cmd_mps;
+        let target = match self.health.health() {
+            Health::Degraded => previous,
+            Health::Nominal | Health::SafeHold => T::ZERO,
+        };
+        let length_m = self.length.length_m().unwrap_or(T::ZERO);
+        let (rate, sat) = self.envelope.limit_request(target, previous, length_m, dt);
+        flags.set(sat.0 & Flags::LENGTH_LIMITED);
+        self.last_rate_cmd_mps = rate;
+        let mu3 = self.cfg.masses.mu3_and_slope(length_m).0;
+        let x_rate = self.existence.normalised_rate(mu3, length_m, rate);
+        let margin = self.equilibrium_margin(x_rate);
+        flags.set_if(margin < T::ZERO, Flags::NO_EQUILIBRIUM);
+        Output {
+            tick,
+            phase: self.sequencer.phase(),
+            health: self.health.health(),
+            rate_cmd_mps: rate,
+            accel_cmd_mps2: (rate - previous) / dt,
+            law_rate_mps: T::ZERO,
+            blend_weight: self.sequencer.blend(tick).weight,
+            alpha_ref_rad,
+            alpha_ref_rate_radps: T::ZERO,
+            delta_rad: T::ZERO,
+            delta_rate_radps: T::ZERO,
+            length_estimate_m: length_m,
+            equilibrium_margin: margin,
+            flags,
+            fault,
+        }
+    }
+
+    /// The Eq. 13 whole-orbit margin of a command whose normalised rate (Eq. 7) is `x`:
+    /// min Depl − |x| (> 0 inside the region). Near docking x grows as 1/l, so the margin is
+    /// reported no lower than −[`MAX_REPORTED_MARGIN`] (it is never above min Depl); a zero
+    /// length estimate (a long coast toward docking) makes x infinite or NaN, reported as that
+    /// bound: far outside.
+    fn equilibrium_margin(&self, x: T) -> T {
+        let margin = self.existence.whole_orbit_margin_of(x);
+        let lowest = T::from_f64(-MAX_REPORTED_MARGIN);
+        if margin >= lowest {
+            margin
+        } else {
+            lowest
+        }
+    }
+
+    /// Records a step's events, in this order: health change, phase change, new fault, blend
+    /// restart. A quiet step (the common case) records nothing.
+    fn record_events(&mut self, health: Health, phase: Phase, out: &Output<T>) {
+        let tick = out.tick;
+        if out.health != health {
+            let kind = EventKind::Health {
+                from: health,
+                to: out.health,
+            };
+            self.events.push(Event { tick, kind });
+        }
+        if out.phase != phase {
+            let kind = EventKind::Phase(out.phase);
+            self.events.push(Event { tick, kind });
+        }
+        if let Some(f) = out.fault {
+            if out.fault != self.last_fault {
+                let kind = EventKind::Fault(f);
+                self.events.push(Event { tick, kind });
+            }
+        }
+        self.last_fault = out.fault;
+        if out.flags.contains(Flags::BLEND_RESTART) {
+            let kind = EventKind::BlendRestart;
+            self.events.push(Event { tick, kind });
+        }
+    }
+}

@@ -1,0 +1,132 @@
+//! What a step tells its caller: the phase, the input health, the fault behind a safe action,
+//! the status flags, and the [`Output`] that carries the command and the parts it was made of.
+
+use crate::envelope::Saturation;
+use crate::law::LawFault;
+use crate::monitor::Sensor;
+
+/// Mission phase.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum Phase {
+    /// Stage 1, paying out.
+    Deploy,
+    /// Stage 1, holding at the stage-1 keep length.
+    Keep1,
+    /// Stage 2, α_r slewing to its plateau.
+    Slew,
+    /// Stage 2, winding in.
+    Retrieve,
+    /// Stage 2, holding at the stage-2 keep length.
+    Keep2,
+}
+
+/// Health of the controller's inputs: the fault state machine.
+///
+/// ```text
+///            bad sample / law fault                more than coast_ticks bad
+///   Nominal ─────────────────────────▶ Degraded ───────────────────────────▶ SafeHold
+///      ▲ ◀──────── next good sample ───────┘                                    │
+///      └──────────────── recovery_ticks good samples in a row ──────────────────┘
+///                        (the Eq. 29 blend restarts from the current rate)
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum Health {
+    /// Valid samples; the law commands the reel.
+    Nominal,
+    /// No usable sample (or no law solution) for at most `coast_ticks`: the reel coasts on its
+    /// last command while the length is predicted from the integrated command.
+    Degraded,
+    /// Too long without a usable sample: the rate is ramped to zero within the acceleration
+    /// limit and held there until the sensors recover.
+    SafeHold,
+}
+
+/// Why this step's command is not the law's value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum Fault {
+    /// A sample was missing or rejected.
+    Sensor(Sensor),
+    /// The law is at one of its singular points.
+    Law(LawFault),
+}
+
+/// Status bits reported with every command.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub struct Flags(pub u32);
+
+impl Flags {
+    /// The law asked for more than the rate limit.
+    pub const RATE_SATURATED: u32 = Saturation::RATE;
+    /// The change from the previous command exceeded the acceleration limit.
+    pub const ACCEL_SATURATED: u32 = Saturation::ACCEL;
+    /// A length limit (docking or spool) restricted the command.
+    pub const LENGTH_LIMITED: u32 = Saturation::LENGTH;
+    /// The command is a safe action, not the law's value (see [`Output::fault`]).
+    pub const SAFE_ACTION: u32 = 1 << 3;
+    /// The blend (Eq. 29) restarted at this step (a stage began, or the controller recovered).
+    pub const BLEND_RESTART: u32 = 1 << 4;
+    /// α_r is slewing (stage 2 start).
+    pub const SLEWING: u32 = 1 << 5;
+    /// [`Output::health`] changed at this step.
+    pub const HEALTH_CHANGED: u32 = 1 << 6;
+    /// The commanded l̇/l lies outside the region where an equilibrium exists over the whole
+    /// orbit (Eq. 13; see [`Output::equilibrium_margin`]). Reported, not acted on: the paper's
+    /// own deployment starts far outside it (l̇/l = 0.1 s⁻¹ at l = 1 m).
+    pub const NO_EQUILIBRIUM: u32 = 1 << 7;
+
+    /// `true` if every bit of `mask` is set.
+    pub fn contains(self, mask: u32) -> bool {
+        self.0 & mask == mask
+    }
+    pub(super) fn set(&mut self, mask: u32) {
+        self.0 |= mask;
+    }
+    pub(super) fn set_if(&mut self, cond: bool, mask: u32) {
+        if cond {
+            self.set(mask);
+        }
+    }
+}
+
+/// What one step decided, and why: the command and the parts it was made of.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub struct Output<T> {
+    /// The tick this output belongs to.
+    pub tick: u32,
+    /// Mission phase after this step.
+    pub phase: Phase,
+    /// Input health after this step.
+    pub health: Health,
+    /// Reel-rate command l̇_real for the coming period, m/s (finite, inside the envelope).
+    pub rate_cmd_mps: T,
+    /// Commanded reel acceleration (Eq. 30, sign corrected; the ramp's slope when a limit or
+    /// safe action shapes the command), m/s².
+    pub accel_cmd_mps2: T,
+    /// The Eq. 27 value l̇ before the blend, m/s (0 when the law did not run).
+    pub law_rate_mps: T,
+    /// Blend weight E = e^{−cτ} of Eq. 29.
+    pub blend_weight: T,
+    /// Reference angle α_r, rad.
+    pub alpha_ref_rad: T,
+    /// α̇_r = (∂α_r/∂l) l̇_real + ∂α_r/∂t, rad/s.
+    pub alpha_ref_rate_radps: T,
+    /// δ = α − α_r, rad (0 when the law did not run).
+    pub delta_rad: T,
+    /// δ̇ = α̇ − α̇_r, rad/s (0 when the law did not run).
+    pub delta_rate_radps: T,
+    /// The length the controller works with: the sensed one, or the prediction from the
+    /// integrated command while coasting, m.
+    pub length_estimate_m: T,
+    /// Signed margin of the commanded x = (2+μ3) l̇/(ωl) inside the whole-orbit existence
+    /// region [max Retr, min Depl] of Eq. 13: > 0 inside, < 0 outside (dimensionless).
+    pub equilibrium_margin: T,
+    /// Status bits.
+    pub flags: Flags,
+    /// The fault behind a safe action, if any.
+    pub fault: Option<Fault>,
+}
