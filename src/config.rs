@@ -34,6 +34,18 @@ pub struct MonitorConfig<T> {
     pub min_orbit_rate_radps: T,
     /// Largest plausible orbit rate, rad/s.
     pub max_orbit_rate_radps: T,
+    /// Persistence and rate of bad samples (FDIR): a leaky counter gains this many for every
+    /// unusable sample and loses one for every usable one, and the controller goes to safe
+    /// hold when it exceeds `coast_ticks × good_samples_per_bad`. So `coast_ticks + 1` bad
+    /// samples in a row still make a safe hold, and so does a sensor that, sustained,
+    /// delivers fewer than `good_samples_per_bad` good samples per bad one (an intermittent
+    /// sensor, whose single good samples would otherwise reset the count for ever).
+    pub good_samples_per_bad: u32,
+    /// Deceleration of the safe-hold ramp to zero, m/s² (used when below the envelope's
+    /// acceleration limit). The reel is rate-commanded and the tether carries the ramp:
+    /// stopping a wind-in (l̈ > 0) lowers the tension by about m_r·l̈ (Eq. 5a), so the ramp is
+    /// kept gentle whatever the nominal envelope.
+    pub safe_hold_decel_mps2: T,
 }
 
 impl<T: Real> MonitorConfig<T> {
@@ -41,7 +53,10 @@ impl<T: Real> MonitorConfig<T> {
     /// length jumps (an 11.8 m/s rate step through a 1 s reel lag is about 12 m), 0.1 rad angle
     /// jumps (the paper's |α̇| stays below 1e-3 rad/s), stuck after 20 identical readings
     /// spanning 1 mrad of implied motion, |α̇| ≤ 0.06 rad/s (≈ 60 n), 1e-5 ≤ n ≤ 0.01 rad/s
-    /// (orbit periods from 10 minutes to a week; LEO is ≈ 1.1e-3).
+    /// (orbit periods from 10 minutes to a week; LEO is ≈ 1.1e-3); a sensor that delivers,
+    /// sustained, more than one bad sample in five (4 good per bad) is declared failed; the
+    /// safe hold ramps at 0.01 m/s² (≈ 1 N on the paper's ≈ 99 kg sub-satellite, where the
+    /// paper's 15 m/s² envelope would change the tension by hundreds of newtons in one tick).
     pub fn default_for_period() -> Self {
         Self {
             coast_ticks: 30,
@@ -53,6 +68,8 @@ impl<T: Real> MonitorConfig<T> {
             max_alpha_rate_radps: T::from_f64(0.06),
             min_orbit_rate_radps: T::from_f64(1e-5),
             max_orbit_rate_radps: T::from_f64(0.01),
+            good_samples_per_bad: 4,
+            safe_hold_decel_mps2: T::from_f64(0.01),
         }
     }
 
@@ -66,6 +83,22 @@ impl<T: Real> MonitorConfig<T> {
         positive("monitor.stuck_motion_rad", self.stuck_motion_rad)?;
         positive("monitor.max_alpha_rate_radps", self.max_alpha_rate_radps)?;
         positive("monitor.min_orbit_rate_radps", self.min_orbit_rate_radps)?;
+        positive(
+            "monitor.good_samples_per_bad",
+            T::from_u32(self.good_samples_per_bad),
+        )?;
+        if self
+            .coast_ticks
+            .checked_mul(self.good_samples_per_bad)
+            .is_none()
+        {
+            return Err(ConfigError::new(
+                "monitor.good_samples_per_bad",
+                T::from_u32(self.good_samples_per_bad),
+                Rule::TooLarge,
+            ));
+        }
+        positive("monitor.safe_hold_decel_mps2", self.safe_hold_decel_mps2)?;
         above(
             "monitor.max_orbit_rate_radps",
             self.max_orbit_rate_radps,
@@ -92,7 +125,9 @@ pub struct Stage2Config<T> {
     pub slew_rate_radps: T,
     /// c of Eq. 29 in stage 2, 1/s.
     pub decay_rate_per_s: T,
-    /// Tick at which stage 2 starts by itself; `None` waits for [`Controller::start_stage2`](crate::controller::Controller::start_stage2).
+    /// Mission time at which stage 2 starts by itself, in ticks since the first step (the
+    /// tick count itself when it starts at 0; a tick counter may start anywhere and wrap);
+    /// `None` waits for [`Controller::start_stage2`](crate::controller::Controller::start_stage2).
     pub start_tick: Option<u32>,
 }
 
@@ -163,6 +198,13 @@ impl<T: Real> Config<T> {
     pub fn validate(&self) -> Result<(), ConfigError> {
         let z = T::ZERO;
         positive("period_s", self.period_s)?;
+        if self.period_s < T::from_f64(MIN_PERIOD_S) {
+            return Err(ConfigError::new(
+                "period_s",
+                self.period_s,
+                Rule::BelowMinimum,
+            ));
+        }
         positive("orbit.semi_major_axis_m", self.orbit.semi_major_axis_m)?;
         positive("orbit.mu_m3ps2", self.orbit.mu_m3ps2)?;
         // Equilibria exist over the whole orbit only for e < 0.75 (Eq. 13, Theorem 1).
@@ -184,8 +226,30 @@ impl<T: Real> Config<T> {
         )?;
         positive("gains.k1_per_s", self.gains.k1_per_s)?;
         positive("gains.k2_per_s2", self.gains.k2_per_s2)?;
+        // The discrete loop must represent Eq. 28: its fastest closed-loop pole, at the control
+        // period, within MAX_POLE_PERIOD_PRODUCT.
+        let pole_step = fastest_eq28_pole_per_s(self.gains.k1_per_s, self.gains.k2_per_s2)
+            * self.period_s.to_f64();
+        if pole_step > MAX_POLE_PERIOD_PRODUCT {
+            // Real roots: k1 sets the fast pole; complex ones: k2 (|s| = √k2).
+            let (k1, k2) = (self.gains.k1_per_s, self.gains.k2_per_s2);
+            let err = if k1.to_f64() * k1.to_f64() >= 4.0 * k2.to_f64() {
+                ConfigError::new("gains.k1_per_s", k1, Rule::TooFastForPeriod)
+            } else {
+                ConfigError::new("gains.k2_per_s2", k2, Rule::TooFastForPeriod)
+            };
+            return Err(err);
+        }
         at_least("stage1.decay_rate_per_s", self.stage1.decay_rate_per_s, z)?;
         at_least("stage2.decay_rate_per_s", self.stage2.decay_rate_per_s, z)?;
+        for (param, c) in [
+            ("stage1.decay_rate_per_s", self.stage1.decay_rate_per_s),
+            ("stage2.decay_rate_per_s", self.stage2.decay_rate_per_s),
+        ] {
+            if c.to_f64() * self.period_s.to_f64() > MAX_POLE_PERIOD_PRODUCT {
+                return Err(ConfigError::new(param, c, Rule::TooFastForPeriod));
+            }
+        }
         positive("stage2.slew_rate_radps", self.stage2.slew_rate_radps)?;
         positive("keep_capture_m", self.keep_capture_m)?;
         let env = &self.envelope;
@@ -262,6 +326,31 @@ impl<T: Real> Config<T> {
     }
 }
 
+/// Shortest control period, s (1 kHz). The law's Eq. 27 and blend are written for a period
+/// far below its time constants (see [`MAX_POLE_PERIOD_PRODUCT`]), so there is no lower limit
+/// from the law; this one keeps the u32 tick count from wrapping in less than 49 days (the
+/// controller handles a wrap, see [`crate::controller`]) and the step (≈ 550 Cortex-M4
+/// instructions) a small share of the period.
+pub const MIN_PERIOD_S: f64 = 1e-3;
+
+/// Largest |s|·Δt of a rate the controller must represent at its period Δt: the fastest Eq. 28
+/// closed-loop pole (the roots of s² + k1 s + k2) and each blend decay rate c (Eq. 29). At
+/// 0.1 the period is a tenth of the fastest time constant (the usual rule for running a
+/// continuous design in discrete time); the paper's gains give 0.003 at 1 s.
+pub const MAX_POLE_PERIOD_PRODUCT: f64 = 0.1;
+
+/// The largest |s| of the roots of s² + k1 s + k2 = 0 (Eq. 28's characteristic polynomial), 1/s:
+/// (k1 + √(k1² − 4k2))/2 when the roots are real, √k2 when they are complex.
+pub fn fastest_eq28_pole_per_s<T: Real>(k1_per_s: T, k2_per_s2: T) -> f64 {
+    let (k1, k2) = (k1_per_s.to_f64(), k2_per_s2.to_f64());
+    let disc = k1 * k1 - 4.0 * k2;
+    if disc >= 0.0 {
+        (k1 + libm::sqrt(disc)) / 2.0
+    } else {
+        libm::sqrt(k2)
+    }
+}
+
 pub(crate) fn finite<T: Real>(param: &'static str, v: T) -> Result<(), ConfigError> {
     if v.is_finite() {
         Ok(())
@@ -317,6 +406,14 @@ pub enum Rule {
     TetherHeavierThanSatellite,
     /// e ≥ 0.75: no equilibrium exists over the whole orbit (Eq. 13).
     NoEquilibrium,
+    /// Below the documented minimum (the control period: [`MIN_PERIOD_S`]).
+    BelowMinimum,
+    /// A rate too fast for the control period to represent: the fastest Eq. 28 closed-loop
+    /// pole or a blend decay rate, times the period, above [`MAX_POLE_PERIOD_PRODUCT`].
+    TooFastForPeriod,
+    /// So large that a derived count overflows (`monitor.coast_ticks ×
+    /// monitor.good_samples_per_bad`).
+    TooLarge,
 }
 
 /// A rejected parameter: its name (the field path in [`Config`]), its value and the rule.

@@ -785,6 +785,8 @@ pub fn config_digest(cfg: &crate::controller::Config<f32>) -> u32 {
         max_alpha_rate_radps,
         min_orbit_rate_radps,
         max_orbit_rate_radps,
+        good_samples_per_bad,
+        safe_hold_decel_mps2,
     } = monitor;
     let schedule = |h: u32, s: &BandSchedule<f32>| {
         let BandSchedule {
@@ -831,6 +833,7 @@ pub fn config_digest(cfg: &crate::controller::Config<f32>) -> u32 {
         max_alpha_rate_radps,
         min_orbit_rate_radps,
         max_orbit_rate_radps,
+        safe_hold_decel_mps2,
     ]
     .into_iter()
     .fold(fnv1a_start(), |h, &x| fnv1a_f32(h, x));
@@ -841,7 +844,12 @@ pub fn config_digest(cfg: &crate::controller::Config<f32>) -> u32 {
         [1, b[0], b[1], b[2], b[3]]
     });
     h = fnv1a(h, &start);
-    for n in [coast_ticks, recovery_ticks, stuck_ticks] {
+    for n in [
+        coast_ticks,
+        recovery_ticks,
+        stuck_ticks,
+        good_samples_per_bad,
+    ] {
         h = fnv1a(h, &n.to_le_bytes());
     }
     h

@@ -32,7 +32,8 @@ pub struct Input<T> {
 pub enum Sensor {
     /// No sample arrived for this tick (dropout).
     Missing,
-    /// The tick count went backwards.
+    /// The tick did not move forward: repeated, or from the past (wrap-aware, see
+    /// [`crate::controller`]).
     Tick,
     /// Length NaN, infinite, below [`MIN_PLAUSIBLE_LENGTH_M`] or beyond the spool (+5 %).
     Length,

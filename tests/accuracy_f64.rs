@@ -240,8 +240,13 @@ fn firmware_replay_f32_vs_f64() {
     );
     f.print("firmware replay (720 s)");
     assert_eq!(f.state_mismatches, 0);
-    // Deployment below 26 km: the goal holds at every step (measured: max 5.3e-7).
-    assert!(f.worst.rel <= GOAL / 10.0, "{:?}", f.worst);
+    // Deployment below 26 km: the goal holds at every step of the law (measured: max 5.3e-7).
+    let law_max = f.rels.last().copied().unwrap_or(0.0);
+    assert!(law_max <= GOAL / 10.0, "law steps: max {law_max:e}");
+    // The safe hold's ramp (0.01 m/s², no longer one step to zero) carries the last law
+    // command's absolute rounding (≈ 1e-8 m/s) down toward zero, where it is a larger share
+    // of a smaller command: measured 1.05e-6 at tick 430 (9.5 mm/s, |Δy| = 1.0e-8 m/s).
+    assert!(f.worst.rel <= 2.0 * GOAL / 10.0, "{:?}", f.worst);
 }
 
 #[test]

@@ -7,7 +7,7 @@
 //! the envelope.
 
 use proptest::prelude::*;
-use tss_reel::controller::{Config, Controller, Envelope, Flags, Input, Output};
+use tss_reel::controller::{Config, Controller, Envelope, Fault, Flags, Input, Output, Sensor};
 
 /// A realistic reel: 10 m/s, 0.1 m/s², 0.5 m to 40 km (tighter than the paper's defaults, so
 /// the limits are exercised).
@@ -63,7 +63,11 @@ fn event() -> impl Strategy<Value = Event> {
     ]
 }
 
-fn assert_output_sane(out: &Output<f32>, prev_rate: f32, elapsed_ticks: u32, env: &Envelope<f32>) {
+/// Every output finite and inside the envelope: the rate within ±max; the command's change
+/// since the previous call, and the commanded acceleration, within the acceleration limit
+/// (a·Δt per call, whatever the pattern of calls: a gap does not allow more, a call whose
+/// tick did not move allows nothing) unless a hard length limit had to act.
+fn assert_output_sane(out: &Output<f32>, prev_rate: f32, env: &Envelope<f32>) {
     let fields = [
         out.rate_cmd_mps,
         out.accel_cmd_mps2,
@@ -87,49 +91,96 @@ fn assert_output_sane(out: &Output<f32>, prev_rate: f32, elapsed_ticks: u32, env
     );
     assert!((0.0..=1.0).contains(&out.blend_weight));
     if !out.flags.contains(Flags::LENGTH_LIMITED) {
-        let dv = env.max_accel_mps2 * elapsed_ticks.max(1) as f32 * 1.0;
+        let a = env.max_accel_mps2; // period 1 s
         assert!(
-            (out.rate_cmd_mps - prev_rate).abs() <= dv * (1.0 + 1e-5) + 1e-6,
+            (out.rate_cmd_mps - prev_rate).abs() <= a * (1.0 + 1e-5) + 1e-6,
             "acceleration limit broken: {prev_rate} -> {out:?}"
         );
+        assert!(
+            out.accel_cmd_mps2.abs() <= a * (1.0 + 1e-5) + 1e-6,
+            "commanded acceleration outside the envelope: {out:?}"
+        );
+        if out.fault == Some(Fault::Sensor(Sensor::Tick)) {
+            assert_eq!(out.rate_cmd_mps, prev_rate, "time did not move: {out:?}");
+        }
     }
+}
+
+/// Flies `events` from tick `start` and checks every output.
+fn fly(start: u32, events: Vec<Event>) {
+    let cfg = config();
+    let env = cfg.envelope;
+    let mut ctl = Controller::new(cfg).unwrap();
+    let mut tick = start;
+    let mut prev_rate = cfg.initial_rate_mps;
+    for ev in events {
+        let out = match ev {
+            Event::Sample {
+                gap,
+                length_m,
+                alpha_rad,
+                alpha_rate_radps,
+                orbit_rate_radps,
+            } => {
+                tick = tick.wrapping_add(gap);
+                ctl.step(&Input {
+                    tick,
+                    length_m,
+                    alpha_rad,
+                    alpha_rate_radps,
+                    orbit_rate_radps,
+                })
+            }
+            Event::Missing { gap } => {
+                tick = tick.wrapping_add(gap);
+                ctl.step_missing(tick)
+            }
+            Event::Backwards { by } => ctl.step_missing(tick.wrapping_sub(by)),
+        };
+        assert_output_sane(&out, prev_rate, &env);
+        prev_rate = out.rate_cmd_mps;
+    }
+}
+
+/// A plausible sample (a slow random walk is not needed: the monitor's consistency checks
+/// reject most of these, which is the point) with a call pattern: the next tick (most often),
+/// the same tick again (a repeat, or a burst of calls in one period), a gap, or a stale tick.
+fn patterned_event() -> impl Strategy<Value = Event> {
+    let gap = prop_oneof![8 => Just(1u32), 2 => Just(0u32), 1 => 2u32..40];
+    prop_oneof![
+        12 => (gap.clone(), 1_000.0f32..1_010.0, -0.8f32..-0.6, -1e-3f32..1e-3, 1.0e-3f32..1.1e-3)
+            .prop_map(|(gap, length_m, alpha_rad, alpha_rate_radps, orbit_rate_radps)| Event::Sample {
+                gap, length_m, alpha_rad, alpha_rate_radps, orbit_rate_radps
+            }),
+        2 => gap.prop_map(|gap| Event::Missing { gap }),
+        1 => (1u32..100).prop_map(|by| Event::Backwards { by }),
+    ]
 }
 
 proptest! {
     #![proptest_config(ProptestConfig { cases: 100_000, ..ProptestConfig::default() })]
 
     /// Any sequence of any inputs: every output finite, the rate within ±max, the change per
-    /// tick within the acceleration limit unless a hard length limit had to act.
+    /// call and the commanded acceleration within the acceleration limit unless a hard length
+    /// limit had to act.
     #[test]
     fn command_always_finite_and_in_envelope(start in any::<u32>(), events in prop::collection::vec(event(), 1..8)) {
-        let cfg = config();
-        let env = cfg.envelope;
-        let mut ctl = Controller::new(cfg).unwrap();
-        let mut tick = start;
-        let mut last_tick: Option<u32> = None;
-        let mut prev_rate = cfg.initial_rate_mps;
-        for ev in events {
-            let out = match ev {
-                Event::Sample { gap, length_m, alpha_rad, alpha_rate_radps, orbit_rate_radps } => {
-                    tick = tick.saturating_add(gap);
-                    ctl.step(&Input { tick, length_m, alpha_rad, alpha_rate_radps, orbit_rate_radps })
-                }
-                Event::Missing { gap } => {
-                    tick = tick.saturating_add(gap);
-                    ctl.step_missing(tick)
-                }
-                Event::Backwards { by } => ctl.step_missing(tick.saturating_sub(by)),
-            };
-            let elapsed = match last_tick {
-                Some(t) if out.tick >= t => out.tick - t,
-                _ => 1,
-            };
-            assert_output_sane(&out, prev_rate, elapsed, &env);
-            if last_tick.is_none_or(|t| out.tick >= t) {
-                last_tick = Some(out.tick);
-            }
-            prev_rate = out.rate_cmd_mps;
-        }
+        fly(start, events);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 1_000, ..ProptestConfig::default() })]
+
+    /// Long sequences (hundreds of calls) of any inputs and of plausible ones, with random
+    /// call patterns (repeats, bursts, gaps, stale ticks, dropouts) from any start tick
+    /// (through the u32 wrap): the same bounds at every call.
+    #[test]
+    fn long_call_patterns_keep_the_envelope(
+        start in any::<u32>(),
+        events in prop::collection::vec(prop_oneof![1 => event(), 4 => patterned_event()], 200..600),
+    ) {
+        fly(start, events);
     }
 }
 

@@ -111,6 +111,8 @@ pub fn monitor_config<T: Real>(sc: &Scenario) -> MonitorConfig<T> {
         max_alpha_rate_radps: T::from_f64(m.max_alpha_rate_radps),
         min_orbit_rate_radps: T::from_f64(m.min_orbit_rate_radps),
         max_orbit_rate_radps: T::from_f64(m.max_orbit_rate_radps),
+        // No scenario keys yet: the controller's defaults.
+        ..MonitorConfig::default_for_period()
     }
 }
 

@@ -29,6 +29,8 @@ pub enum EventKind {
     Phase(Phase),
     /// The Eq. 29 blend restarted (a stage began, or the controller recovered).
     BlendRestart,
+    /// This phase stopped getting closer to its keep length ([`super::Flags::NO_PROGRESS`]).
+    NoProgress(Phase),
 }
 
 /// An event and the tick it happened at.

@@ -6,12 +6,15 @@ use crate::real::Real;
 
 use super::output::{Flags, Health};
 
-/// The fault state machine: how long the inputs have been bad, and how long good again.
+/// The fault state machine, with persistence and rate (FDIR): a leaky counter of unusable
+/// samples (see [`MonitorConfig::good_samples_per_bad`]), and how long the inputs have been
+/// good again in safe hold.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct HealthMachine {
     health: Health,
-    /// Consecutive ticks without a usable sample or law solution.
-    bad_ticks: u32,
+    /// The leaky counter: + `good_samples_per_bad` for every unusable sample (or law fault),
+    /// − 1 for every usable one.
+    fault_level: u32,
     /// Consecutive valid samples while in safe hold.
     good_ticks: u32,
 }
@@ -20,7 +23,7 @@ impl HealthMachine {
     pub(super) const fn new() -> Self {
         Self {
             health: Health::Nominal,
-            bad_ticks: 0,
+            fault_level: 0,
             good_ticks: 0,
         }
     }
@@ -37,19 +40,23 @@ impl HealthMachine {
         }
     }
 
-    /// A usable sample that the law could use: Nominal.
+    /// A usable sample that the law could use: Nominal, and the counter leaks by one.
     pub(super) fn usable(&mut self, flags: &mut Flags) {
         self.set(Health::Nominal, flags);
-        self.bad_ticks = 0;
+        self.fault_level = self.fault_level.saturating_sub(1);
         self.good_ticks = 0;
     }
 
-    /// No usable sample or law solution at this tick: Degraded for up to `coast_ticks`, then
-    /// SafeHold (which only valid samples leave, see [`HealthMachine::recovered`]).
+    /// No usable sample or law solution at this tick: Degraded, until the leaky counter
+    /// exceeds `coast_ticks × good_samples_per_bad` (`coast_ticks + 1` bad samples in a row
+    /// from a clean record, sooner after recent faults): then SafeHold, which only
+    /// `recovery_ticks` valid samples in a row leave (see [`HealthMachine::recovered`]).
     pub(super) fn unusable<T>(&mut self, cfg: &MonitorConfig<T>, flags: &mut Flags) {
-        self.bad_ticks = self.bad_ticks.saturating_add(1);
+        self.fault_level = self.fault_level.saturating_add(cfg.good_samples_per_bad);
         self.good_ticks = 0;
-        let next = if self.health == Health::SafeHold || self.bad_ticks > cfg.coast_ticks {
+        // (`Config::validate` checks that the product does not saturate.)
+        let limit = cfg.coast_ticks.saturating_mul(cfg.good_samples_per_bad);
+        let next = if self.health == Health::SafeHold || self.fault_level > limit {
             Health::SafeHold
         } else {
             Health::Degraded
@@ -57,11 +64,16 @@ impl HealthMachine {
         self.set(next, flags);
     }
 
-    /// A valid sample in safe hold: `true` once `recovery_ticks` have arrived in a row (the
-    /// law may run again; [`HealthMachine::usable`] then makes the health Nominal).
+    /// A valid sample in safe hold: `true` once `recovery_ticks` have arrived in a row, which
+    /// clears the counter (the law may run again; [`HealthMachine::usable`] then makes the
+    /// health Nominal).
     pub(super) fn recovered<T>(&mut self, cfg: &MonitorConfig<T>) -> bool {
         self.good_ticks = self.good_ticks.saturating_add(1);
-        self.good_ticks >= cfg.recovery_ticks
+        let recovered = self.good_ticks >= cfg.recovery_ticks;
+        if recovered {
+            self.fault_level = 0;
+        }
+        recovered
     }
 }
 

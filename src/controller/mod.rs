@@ -34,6 +34,7 @@
 //! Time is an integer tick count (one tick = one control period); the controller never
 //! accumulates time in floating point.
 
+mod clock;
 mod events;
 mod health;
 mod output;
@@ -51,9 +52,12 @@ pub use crate::monitor::{Input, Sensor};
 pub use events::{Event, EventKind, EVENT_CAPACITY};
 pub use output::{Fault, Flags, Health, Output, Phase};
 
+use clock::{Clock, Elapsed};
 use events::EventRing;
 use health::{DeadReckoning, HealthMachine};
-use sequencer::Sequencer;
+use sequencer::{Progress, Sequencer};
+
+pub use sequencer::PROGRESS_TIME_CONSTANTS;
 
 /// Bound on the reported [`Output::equilibrium_margin`] (x grows as 1/l toward docking).
 pub const MAX_REPORTED_MARGIN: f64 = 1e6;
@@ -69,8 +73,11 @@ pub struct Controller<T: Real> {
     sequencer: Sequencer<T>,
     health: HealthMachine,
     length: DeadReckoning<T>,
-    /// The tick of the last step whose time was accepted (`None` before the first step).
-    last_tick: Option<u32>,
+    /// The time base: the last accepted tick.
+    clock: Clock,
+    /// The safe hold's largest change of rate in one period, m/s: the smaller of
+    /// `monitor.safe_hold_decel_mps2` and the envelope's acceleration limit, times the period.
+    safe_hold_step_mps: T,
     /// The command of the last step, m/s (l̇0 before the first).
     last_rate_cmd_mps: T,
     /// The fault of the last step (a fault is an event when it differs from the last).
@@ -101,7 +108,12 @@ impl<T: Real> Controller<T> {
             sequencer: Sequencer::new(&cfg),
             health: HealthMachine::new(),
             length: DeadReckoning::new(spool_m),
-            last_tick: None,
+            clock: Clock::new(),
+            safe_hold_step_mps: cfg
+                .monitor
+                .safe_hold_decel_mps2
+                .min(cfg.envelope.max_accel_mps2)
+                * cfg.period_s,
             last_rate_cmd_mps: cfg.initial_rate_mps,
             last_fault: None,
             events: EventRing::new(),
@@ -191,26 +203,22 @@ impl<T: Real> Controller<T> {
         let mut flags = Flags::default();
         let dt = self.cfg.period_s;
 
-        // The time base: a tick that goes backwards is a bad sample; time does not move.
-        let elapsed_ticks = match self.last_tick {
-            None => 0,
-            Some(last) if tick >= last => tick - last,
-            Some(_) => {
-                let unmoved = self.length.length_m();
-                return self.reject(tick, unmoved, Fault::Sensor(Sensor::Tick), None, flags);
+        // The time base: a tick that did not move forward (repeated, or from the past) is a
+        // bad sample, and time does not move (see `clock`).
+        let elapsed_ticks = match self.clock.advance(tick) {
+            Ok(Elapsed::First) => {
+                // Sequence the mission: stage 1 begins with the first step (SPEC §7).
+                self.sequencer.begin_stage1(tick, &mut flags);
+                0
             }
+            Ok(Elapsed::Ticks(n)) => n,
+            Err(s) => return self.reject_stale(tick, Fault::Sensor(s), flags),
         };
-        let first = self.last_tick.is_none();
-        self.last_tick = Some(tick);
         let elapsed_s = T::from_u32(elapsed_ticks) * dt;
         // Dead reckoning: the reel ran at the last command since the last step.
         let predicted_m = self.length.predict(self.last_rate_cmd_mps, elapsed_s);
 
-        // Sequence the mission: stage 1 with the first step, stage 2 at its tick or on
-        // command, each restarting the blend (SPEC §7).
-        if first {
-            self.sequencer.begin_stage1(tick, &mut flags);
-        }
+        // Sequence the mission: stage 2 at its tick or on command, restarting the blend.
         self.sequencer
             .begin_stage2_if_due(tick, self.last_rate_cmd_mps, &mut flags);
 
@@ -232,7 +240,7 @@ impl<T: Real> Controller<T> {
         let reference = self.sequencer.reference(tick, x.length_m);
         if self.health.health() == Health::SafeHold {
             if !self.health.recovered(&self.cfg.monitor) {
-                return self.hold(tick, reference.angle.angle_rad, None, flags);
+                return self.hold(tick, Some(tick), reference.angle.angle_rad, None, flags);
             }
             // Recovered: re-engage the law through the Eq. 29 blend from the current rate.
             self.sequencer
@@ -267,22 +275,39 @@ impl<T: Real> Controller<T> {
             };
         self.health.usable(&mut flags);
 
-        // The envelope. The first step has no previous period: it is judged over one period.
-        let limit_s = if elapsed_ticks == 0 { dt } else { elapsed_s };
+        // The envelope. The acceleration limit holds per command: a command differs from the
+        // previous one by at most a·Δt, whatever the calls' pattern (a gap of n ticks does
+        // not allow n·a·Δt: the reel ran at the previous command all along, and would step).
         let previous = self.last_rate_cmd_mps;
         let (rate, sat) = self
             .envelope
-            .limit_request(law.rate_mps, previous, x.length_m, limit_s);
+            .limit_request(law.rate_mps, previous, x.length_m, dt);
         flags.set(sat.0);
         flags.set_if(reference.slewing, Flags::SLEWING);
-        // A limited command's acceleration is its change over the period; otherwise Eq. 30's.
+        // A limited command's acceleration is its change over the period. Otherwise Eq. 30's,
+        // bounded like every commanded quantity: Eq. 30 is the law's derivative, which leaves
+        // the envelope where the law's rate jumps (a blend restart from a held rate).
+        let max_accel = self.cfg.envelope.max_accel_mps2;
         let accel = if sat.any() {
-            (rate - previous) / limit_s
+            (rate - previous) / dt
+        } else if accel_mps2.abs() > max_accel {
+            flags.set(Flags::ACCEL_SATURATED);
+            accel_mps2.clamp_finite(-max_accel, max_accel)
         } else {
             accel_mps2
         };
         self.last_rate_cmd_mps = rate;
         self.sequencer.advance_phase(x.length_m, reference.slewing);
+        match self.sequencer.watch_progress(tick, x.length_m) {
+            Progress::OnTrack => {}
+            Progress::Stalled { first } => {
+                flags.set(Flags::NO_PROGRESS);
+                if first {
+                    let kind = EventKind::NoProgress(self.sequencer.phase());
+                    self.events.push(Event { tick, kind });
+                }
+            }
+        }
 
         // The output.
         let x_rate = self
@@ -327,25 +352,48 @@ impl<T: Real> Controller<T> {
             let l = self.length.length_m().unwrap_or(T::ZERO);
             self.sequencer.reference(tick, l).angle.angle_rad
         });
-        self.hold(tick, alpha_ref_rad, Some(fault), flags)
+        self.hold(tick, Some(tick), alpha_ref_rad, Some(fault), flags)
     }
 
-    /// The safe actions. Degraded: keep the last command (coast). Safe hold: ramp the rate to
-    /// zero at the acceleration limit. Both stay inside the length limits, judged on the
-    /// estimated length (before any accepted sample, on the docking end: 0 m).
+    /// A sample whose tick did not move forward: a bad sample for the health machine, at a
+    /// time that did not move. The length estimate stays, and so does the command (no time
+    /// passed for the acceleration limit to allow a change, in any health state); α_r and the
+    /// blend are reported at the last accepted tick. A clock that stops for good therefore
+    /// ends in safe hold with the command held where it was, until time moves again.
+    fn reject_stale(&mut self, tick: u32, fault: Fault, mut flags: Flags) -> Output<T> {
+        self.health.unusable(&self.cfg.monitor, &mut flags);
+        // (Only a tick after an accepted one can be stale or repeated.)
+        let now = self.clock.last_tick().unwrap_or(tick);
+        let l = self.length.length_m().unwrap_or(T::ZERO);
+        let alpha_ref_rad = self.sequencer.reference(now, l).angle.angle_rad;
+        self.hold(tick, None, alpha_ref_rad, Some(fault), flags)
+    }
+
+    /// The safe actions at `tick`: `moved_to` is `Some(tick)` when time moved to it, `None`
+    /// when the tick did not move forward (time stays at the last accepted tick). Degraded:
+    /// keep the last command (coast). Safe hold: ramp the rate to zero at
+    /// `monitor.safe_hold_decel_mps2` (at most the envelope's limit). When time did not move,
+    /// the command stays. All stay inside the length limits, judged on the estimated length
+    /// (before any accepted sample, on the docking end: 0 m).
     fn hold(
         &mut self,
         tick: u32,
+        moved_to: Option<u32>,
         alpha_ref_rad: T,
         fault: Option<Fault>,
         mut flags: Flags,
     ) -> Output<T> {
         flags.set(Flags::SAFE_ACTION);
+        flags.set_if(self.sequencer.stalled(), Flags::NO_PROGRESS);
+        let now = moved_to.or(self.clock.last_tick()).unwrap_or(tick);
         let dt = self.cfg.period_s;
         let previous = self.last_rate_cmd_mps;
-        let target = match self.health.health() {
-            Health::Degraded => previous,
-            Health::Nominal | Health::SafeHold => T::ZERO,
+        let target = match (moved_to, self.health.health()) {
+            (None, _) | (Some(_), Health::Degraded) => previous,
+            (Some(_), Health::Nominal | Health::SafeHold) => {
+                let step = self.safe_hold_step_mps;
+                previous - previous.clamp_finite(-step, step)
+            }
         };
         let length_m = self.length.length_m().unwrap_or(T::ZERO);
         let (rate, sat) = self.envelope.limit_request(target, previous, length_m, dt);
@@ -362,7 +410,7 @@ impl<T: Real> Controller<T> {
             rate_cmd_mps: rate,
             accel_cmd_mps2: (rate - previous) / dt,
             law_rate_mps: T::ZERO,
-            blend_weight: self.sequencer.blend(tick).weight,
+            blend_weight: self.sequencer.blend(now).weight,
             alpha_ref_rad,
             alpha_ref_rate_radps: T::ZERO,
             delta_rad: T::ZERO,

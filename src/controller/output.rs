@@ -24,12 +24,17 @@ pub enum Phase {
 /// Health of the controller's inputs: the fault state machine.
 ///
 /// ```text
-///            bad sample / law fault                more than coast_ticks bad
+///            bad sample / law fault             fault counter > coast_ticks × G
 ///   Nominal ─────────────────────────▶ Degraded ───────────────────────────▶ SafeHold
 ///      ▲ ◀──────── next good sample ───────┘                                    │
 ///      └──────────────── recovery_ticks good samples in a row ──────────────────┘
 ///                        (the Eq. 29 blend restarts from the current rate)
 /// ```
+///
+/// The fault counter is leaky (persistence and rate, as flight FDIR counts): + G for every
+/// bad sample, − 1 for every good one, G = `monitor.good_samples_per_bad`. So coast_ticks + 1
+/// bad samples in a row reach safe hold, and so does an intermittent sensor that delivers,
+/// sustained, fewer than G good samples per bad one; recovery clears the counter.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub enum Health {
@@ -38,8 +43,9 @@ pub enum Health {
     /// No usable sample (or no law solution) for at most `coast_ticks`: the reel coasts on its
     /// last command while the length is predicted from the integrated command.
     Degraded,
-    /// Too long without a usable sample: the rate is ramped to zero within the acceleration
-    /// limit and held there until the sensors recover.
+    /// Too long without a usable sample (or too few usable ones): the rate is ramped to zero
+    /// at `monitor.safe_hold_decel_mps2` (within the acceleration limit) and held there until
+    /// the sensors recover.
     SafeHold,
 }
 
@@ -77,6 +83,11 @@ impl Flags {
     /// orbit (Eq. 13; see [`Output::equilibrium_margin`]). Reported, not acted on: the paper's
     /// own deployment starts far outside it (l̇/l = 0.1 s⁻¹ at l = 1 m).
     pub const NO_EQUILIBRIUM: u32 = 1 << 7;
+    /// The phase (Deploy or Retrieve) has stopped getting closer to its keep length (see
+    /// [`crate::controller::PROGRESS_TIME_CONSTANTS`]). Reported, not acted on: the law still
+    /// holds the tether in an equilibrium (a sensor bias moves it, HZ-4); stopping the reel
+    /// would end the progress for good and can slacken a short tether; the ground decides.
+    pub const NO_PROGRESS: u32 = 1 << 8;
 
     /// `true` if every bit of `mask` is set.
     pub fn contains(self, mask: u32) -> bool {
@@ -86,9 +97,7 @@ impl Flags {
         self.0 |= mask;
     }
     pub(super) fn set_if(&mut self, cond: bool, mask: u32) {
-        if cond {
-            self.set(mask);
-        }
+        self.0 |= if cond { mask } else { 0 };
     }
 }
 
@@ -105,7 +114,9 @@ pub struct Output<T> {
     /// Reel-rate command l̇_real for the coming period, m/s (finite, inside the envelope).
     pub rate_cmd_mps: T,
     /// Commanded reel acceleration (Eq. 30, sign corrected; the ramp's slope when a limit or
-    /// safe action shapes the command), m/s².
+    /// safe action shapes the command), m/s². Inside ±`max_accel_mps2` (Eq. 30's value is
+    /// bounded, [`Flags::ACCEL_SATURATED`]), except where a length limit had to override the
+    /// acceleration limit ([`Flags::LENGTH_LIMITED`]).
     pub accel_cmd_mps2: T,
     /// The Eq. 27 value l̇ before the blend, m/s (0 when the law did not run).
     pub law_rate_mps: T,

@@ -8,6 +8,14 @@
 //!
 //! Stage 1 begins with the first step; stage 2 at its configured tick or on command, from
 //! whichever stage-1 phase the mission is in.
+//!
+//! **Progress.** Deploy and Retrieve each head for a keep length. A phase that stops getting
+//! closer to it (a 5° α bias leaves the paper's retrieval at 2 364 m for ever, HZ-14) is
+//! detected: no new closest approach by [`Config::keep_capture_m`] within
+//! [`PROGRESS_TIME_CONSTANTS`] × the slowest time constant of the stage's loop (the Eq. 28
+//! envelope decay 2/k1, the Eq. 29 blend 1/c) is reported as [`Progress::Stalled`] (the
+//! controller's `NO_PROGRESS` flag and event). The watch restarts with each blend restart
+//! (stage start, recovery) and each phase.
 
 use crate::config::Config;
 use crate::law::Blend;
@@ -16,10 +24,38 @@ use crate::schedule::{PreparedBand, Reference};
 
 use super::output::{Flags, Phase};
 
+/// The progress window, in time constants of the stage's loop (see the module docs): long
+/// enough that the exponential approach of the paper's phases to their keep lengths always
+/// gains the capture distance within it.
+pub const PROGRESS_TIME_CONSTANTS: f64 = 5.0;
+
+/// Whether the phase is getting closer to its keep length.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Progress {
+    /// Closer within the window (or a phase without a target length).
+    OnTrack,
+    /// No closer for longer than the window.
+    Stalled {
+        /// The stall was found at this step.
+        first: bool,
+    },
+}
+
+/// The closest approach of the current phase to its keep length.
+#[derive(Clone, Copy, Debug)]
+struct Approach<T> {
+    /// The smallest distance to the keep length so far, m.
+    closest_m: T,
+    /// The tick it was reached at.
+    tick: u32,
+    /// The stall was reported.
+    stalled: bool,
+}
+
 /// When stage 2 (retrieval) begins.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Stage2Start {
-    /// At the first step at or after this tick, unless asked for earlier.
+    /// At this mission time (ticks since the first step), unless asked for earlier.
     At(u32),
     /// Only when asked for.
     OnRequest,
@@ -46,6 +82,8 @@ struct BlendStart<T> {
 #[derive(Clone, Debug)]
 pub(super) struct Sequencer<T> {
     phase: Phase,
+    /// The tick of the first step.
+    mission_start_tick: u32,
     /// The tick the current stage began at.
     stage_start_tick: u32,
     stage2: Stage2Start,
@@ -64,6 +102,13 @@ pub(super) struct Sequencer<T> {
     keep2_entry_m: T,
     slew_rate_radps: T,
     period_s: T,
+    /// The current phase's closest approach to its keep length (`None` when the watch has
+    /// just (re)started or the phase has no target length).
+    approach: Option<Approach<T>>,
+    /// The progress window of stage 1 and stage 2, ticks.
+    progress_window_ticks: [u32; 2],
+    /// The progress a window must make, m.
+    min_progress_m: T,
 }
 
 impl<T: Real> Sequencer<T> {
@@ -74,8 +119,18 @@ impl<T: Real> Sequencer<T> {
         let log2_weight = |c: T| T::from_f64(-c.to_f64() * dt * core::f64::consts::LOG2_E);
         let decay_rate_per_s = [cfg.stage1.decay_rate_per_s, cfg.stage2.decay_rate_per_s];
         let log2_weight_per_tick = decay_rate_per_s.map(log2_weight);
+        // The slowest time constant of each stage's loop: 2/k1 (Eq. 28's envelope, e^{−k1 t/2})
+        // and 1/c (Eq. 29; none when c = 0), in periods.
+        let envelope_s = 2.0 / cfg.gains.k1_per_s.to_f64();
+        let window = |c: T| {
+            let blend_s = if c > T::ZERO { 1.0 / c.to_f64() } else { 0.0 };
+            let ticks = PROGRESS_TIME_CONSTANTS * envelope_s.max(blend_s) / dt;
+            // (`as` saturates: a window beyond u32 never elapses.)
+            libm::ceil(ticks) as u32
+        };
         Self {
             phase: Phase::Deploy,
+            mission_start_tick: 0,
             stage_start_tick: 0,
             stage2: match cfg.stage2.start_tick {
                 Some(tick) => Stage2Start::At(tick),
@@ -95,6 +150,9 @@ impl<T: Real> Sequencer<T> {
             keep2_entry_m: cfg.stage2.schedule.low_length_m + cfg.keep_capture_m,
             slew_rate_radps: cfg.stage2.slew_rate_radps,
             period_s: cfg.period_s,
+            approach: None,
+            progress_window_ticks: decay_rate_per_s.map(window),
+            min_progress_m: cfg.keep_capture_m,
         }
     }
 
@@ -120,6 +178,7 @@ impl<T: Real> Sequencer<T> {
 
     /// Begins stage 1 at the first step: its blend starts from l̇0.
     pub(super) fn begin_stage1(&mut self, tick: u32, flags: &mut Flags) {
+        self.mission_start_tick = tick;
         self.stage_start_tick = tick;
         self.restart_blend(tick, self.blend.initial_rate_mps, flags);
     }
@@ -128,7 +187,8 @@ impl<T: Real> Sequencer<T> {
     /// blend restarts from the current rate `rate_mps`.
     pub(super) fn begin_stage2_if_due(&mut self, tick: u32, rate_mps: T, flags: &mut Flags) {
         let due = match self.stage2 {
-            Stage2Start::At(start) => tick >= start,
+            // Mission time: ticks since the first step (modulo 2³², as every tick difference).
+            Stage2Start::At(start) => tick.wrapping_sub(self.mission_start_tick) >= start,
             Stage2Start::Requested => true,
             Stage2Start::OnRequest | Stage2Start::Begun => false,
         };
@@ -149,16 +209,18 @@ impl<T: Real> Sequencer<T> {
             decay_rate_per_s: self.decay_rate_per_s[stage],
             log2_weight_per_tick: self.log2_weight_per_tick[stage],
         };
+        self.approach = None;
         flags.set(Flags::BLEND_RESTART);
     }
 
     /// E = e^{−cτ} and 1 − E at `tick`, τ = k·Δt the time since the blend (re)started k ticks
-    /// before (Eq. 29), as 2^{k·(−cΔt·log₂e)}. A tick before the start counts as the start.
+    /// before (Eq. 29), as 2^{k·(−cΔt·log₂e)}. `tick` is an accepted tick: at or after the
+    /// start, modulo 2³² (see `clock`).
     // Inlined into both callers (the step and the safe action): with `reference`, 37
     // instructions less on the mission's worst step (scripts/bench-target: 580 → 543).
     #[inline(always)]
     pub(super) fn blend(&self, tick: u32) -> Blend<T> {
-        let k = T::from_u32(tick.saturating_sub(self.blend.tick));
+        let k = T::from_u32(tick.wrapping_sub(self.blend.tick));
         Blend::from_log2(self.blend.log2_weight_per_tick * k)
     }
 
@@ -181,7 +243,7 @@ impl<T: Real> Sequencer<T> {
         let band = match self.phase {
             Phase::Deploy | Phase::Keep1 => &self.stage1_band,
             Phase::Slew => {
-                let ticks = tick.saturating_sub(self.stage_start_tick);
+                let ticks = tick.wrapping_sub(self.stage_start_tick);
                 let tau_s = T::from_u32(ticks) * self.period_s;
                 return self
                     .stage2_band
@@ -201,11 +263,47 @@ impl<T: Real> Sequencer<T> {
     /// schedule (for good), Retrieve becomes Keep2 at the stage-2 keep length (plus the
     /// capture). The keep phases last until the next stage or the end.
     pub(super) fn advance_phase(&mut self, length_m: T, slewing: bool) {
-        match self.phase {
-            Phase::Deploy if length_m >= self.keep1_entry_m => self.phase = Phase::Keep1,
-            Phase::Slew if !slewing => self.phase = Phase::Retrieve,
-            Phase::Retrieve if length_m <= self.keep2_entry_m => self.phase = Phase::Keep2,
-            Phase::Deploy | Phase::Keep1 | Phase::Slew | Phase::Retrieve | Phase::Keep2 => {}
+        let next = match self.phase {
+            Phase::Deploy if length_m >= self.keep1_entry_m => Phase::Keep1,
+            Phase::Slew if !slewing => Phase::Retrieve,
+            Phase::Retrieve if length_m <= self.keep2_entry_m => Phase::Keep2,
+            Phase::Deploy | Phase::Keep1 | Phase::Slew | Phase::Retrieve | Phase::Keep2 => return,
+        };
+        self.phase = next;
+        self.approach = None;
+    }
+
+    /// Whether the current phase still gets closer to its keep length, with the sensed
+    /// `length_m` at `tick` (see the module docs).
+    pub(super) fn watch_progress(&mut self, tick: u32, length_m: T) -> Progress {
+        let distance_m = match self.phase {
+            Phase::Deploy => self.keep1_entry_m - length_m,
+            Phase::Retrieve => length_m - self.keep2_entry_m,
+            Phase::Keep1 | Phase::Slew | Phase::Keep2 => return Progress::OnTrack,
+        };
+        let window_ticks = self.progress_window_ticks[self.stage()];
+        match &mut self.approach {
+            Some(a) if distance_m > a.closest_m - self.min_progress_m => {
+                if tick.wrapping_sub(a.tick) <= window_ticks {
+                    return Progress::OnTrack;
+                }
+                let first = !a.stalled;
+                a.stalled = true;
+                Progress::Stalled { first }
+            }
+            _ => {
+                self.approach = Some(Approach {
+                    closest_m: distance_m,
+                    tick,
+                    stalled: false,
+                });
+                Progress::OnTrack
+            }
         }
+    }
+
+    /// The current phase was found stalled and has not progressed since.
+    pub(super) fn stalled(&self) -> bool {
+        self.approach.is_some_and(|a| a.stalled)
     }
 }
