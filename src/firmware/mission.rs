@@ -1,7 +1,7 @@
 //! What the firmware does on each control tick: the reel controller flying a recorded stretch
 //! of the paper's mission.
 //!
-//! The built-in test input ([`super::replay_data`]) is the first 720 s of `scenarios/paper.toml`
+//! The built-in test input ([`tss_reel::recordings::replay`]) is the first 720 s of `scenarios/paper.toml`
 //! as the reel MCU senses it, recorded from `tss-sim`, with a sensor dropout injected at ticks
 //! 400..450 (longer than the controller's 30-tick coast, so it goes Degraded → SafeHold and
 //! recovers). The replay implements the [`tss_reel::hal`] sensor traits; the reel drive is a
@@ -19,13 +19,13 @@
 //! `scripts/firmware-log`, and every logged command (and the digest of all of them) is checked
 //! bit for bit against the same core compiled for the host by `tests/firmware_replay.rs`.
 
-use super::replay_data::{
-    DROPOUT_FROM_TICK, DROPOUT_UNTIL_TICK, ORBIT_RATE_RADPS, PERIOD_S, SAMPLES,
-};
 use tss_reel::controller::{Config, Controller, Output};
 use tss_reel::hal::{
     control_cycle, Devices, ErrorKind, ErrorType, LengthSensor, OrbitRateSource, ReelDrive, Swing,
     SwingSensor,
+};
+use tss_reel::recordings::replay::{
+    DROPOUT_FROM_TICK, DROPOUT_UNTIL_TICK, ORBIT_RATE_RADPS, PERIOD_S, SAMPLES,
 };
 
 /// Control period, ms: 1 s, the period of the paper's scenario and of the recording.
@@ -130,6 +130,9 @@ pub struct Mission {
 
 impl Mission {
     /// Sets the mission up (called once, before the first tick).
+    // No `Default`: setting up may end the run (a rejected configuration exits with failure),
+    // which a default value must not do.
+    #[allow(clippy::new_without_default)]
     pub fn new() -> Self {
         // The paper's configuration is valid by construction; a rejection would be a build
         // defect, reported on the first tick.
