@@ -27,14 +27,14 @@ use tss_reel::firmware::{self, clock::ControlClock, exit, mission};
 
 /// Reset entry: start the clock, run the mission one step per control tick, exit.
 ///
+/// The stack was painted by cortex-m-rt's reset handler (feature `paint-stack`) before this
+/// runs, so the high-water mark logged at the end counts every frame since reset.
+///
 /// The loop is bounded by [`mission::MAX_TICKS`]: a mission that does not finish in time is a
 /// failure, never a hang.
 #[cfg(target_os = "none")]
 #[cortex_m_rt::entry]
 fn main() -> ! {
-    // Fill the unused stack with a pattern, so the high-water mark can be read at the end.
-    firmware::stack::paint();
-
     defmt::info!(
         "tss-reel firmware {=str}: control period {=u32} ms",
         env!("CARGO_PKG_VERSION"),

@@ -11,7 +11,7 @@
 //!   the main loop does not change when it is;
 //! - [`pil`]: the processor-in-the-loop mission over UART0 ([`uart`]), selected by `pil` on the
 //!   semihosting command line ([`cmdline`]; QEMU `-append pil`);
-//! - [`stack`]: the stack painter and its high-water mark.
+//! - [`stack`]: the stack high-water mark (the stack is painted by cortex-m-rt at reset).
 //!
 //! This module also links the two runtime crates that have no API to call:
 //! - `defmt-semihosting` is the global defmt logger (frames go out through semihosting stdout);
