@@ -21,8 +21,8 @@
 
 use tss_reel::controller::{Config, Controller, Output};
 use tss_reel::hal::{
-    control_cycle, Devices, ErrorKind, ErrorType, LengthSensor, OrbitRateSource, ReelDrive, Swing,
-    SwingSensor,
+    control_cycle, Cycle, Devices, ErrorKind, ErrorType, LengthSensor, OrbitRateSource, ReelDrive,
+    Swing, SwingSensor,
 };
 use tss_reel::recordings::replay::{
     DROPOUT_FROM_TICK, DROPOUT_UNTIL_TICK, ORBIT_RATE_RADPS, PERIOD_S, SAMPLES,
@@ -154,6 +154,16 @@ impl Mission {
         }
     }
 
+    /// One control cycle: read the replay's sensors, step the controller
+    /// ([`Controller::step`], or `step_missing` in a dropout), command the reel.
+    ///
+    /// Out of line on purpose: it is the flight ELF's symbol for the control path, from which
+    /// `scripts/panic-check` proves that no panic is reachable.
+    #[inline(never)]
+    fn control(&mut self, tick: u32) -> Cycle {
+        control_cycle(&mut self.controller, tick, &mut self.devices)
+    }
+
     /// One control step at tick `tick` (0 for the first).
     pub fn step(&mut self, tick: u32) -> Flow {
         if tick == 0 {
@@ -176,7 +186,7 @@ impl Mission {
             return Flow::Finished;
         }
 
-        let cycle = control_cycle(&mut self.controller, tick, &mut self.devices);
+        let cycle = self.control(tick);
         if let Some(e) = cycle.reel_error {
             defmt::error!("t={=u32} reel refused the command: {}", tick, e);
             return Flow::Failed;
