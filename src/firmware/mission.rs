@@ -24,6 +24,7 @@ use tss_reel::hal::{
     control_cycle, Cycle, Devices, ErrorKind, ErrorType, LengthSensor, OrbitRateSource, ReelDrive,
     Swing, SwingSensor,
 };
+use tss_reel::link::{fnv1a_f32, fnv1a_start};
 use tss_reel::recordings::replay::{
     DROPOUT_FROM_TICK, DROPOUT_UNTIL_TICK, ORBIT_RATE_RADPS, PERIOD_S, SAMPLES,
 };
@@ -99,7 +100,8 @@ impl OrbitRateSource for CircularOrbit {
 
 /// The reel drive of the replay: a telemetry sink that checks and fingerprints each command.
 struct TelemetryReel {
-    /// FNV-1a over the bit patterns of all rate commands (as `tests/firmware_replay.rs`).
+    /// FNV-1a over the bit patterns of all rate commands ([`fnv1a_f32`], as the PIL link's
+    /// `Report` frame and `tests/firmware_replay.rs`).
     digest: u32,
     /// Commands received.
     count: u32,
@@ -114,10 +116,8 @@ impl ReelDrive for TelemetryReel {
         if !output.rate_cmd_mps.is_finite() {
             return Err(ErrorKind::Device);
         }
-        for b in output.rate_cmd_mps.to_bits().to_le_bytes() {
-            self.digest = (self.digest ^ u32::from(b)).wrapping_mul(0x0100_0193);
-        }
-        self.count += 1;
+        self.digest = fnv1a_f32(self.digest, output.rate_cmd_mps);
+        self.count = self.count.saturating_add(1);
         Ok(())
     }
 }
@@ -147,7 +147,7 @@ impl Mission {
                 swing: Replay,
                 orbit: CircularOrbit,
                 reel: TelemetryReel {
-                    digest: 0x811c_9dc5,
+                    digest: fnv1a_start(),
                     count: 0,
                 },
             },
