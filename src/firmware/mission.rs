@@ -187,6 +187,19 @@ impl Mission {
         }
 
         let cycle = self.control(tick);
+        // In detail (`DEFMT_LOG=debug`): what this cycle sensed and what it commanded.
+        match Replay::sample(tick) {
+            Ok(&[length_m, alpha_rad, alpha_rate_radps]) => defmt::debug!(
+                "t={=u32} sensed: l={=f32} m alpha={=f32} rad alpha_rate={=f32} rad/s n={=f32} rad/s",
+                tick,
+                length_m,
+                alpha_rad,
+                alpha_rate_radps,
+                ORBIT_RATE_RADPS
+            ),
+            Err(e) => defmt::debug!("t={=u32} sensed: nothing ({})", tick, e),
+        }
+        defmt::debug!("t={=u32} output: {}", tick, self.controller.output());
         if let Some(e) = cycle.reel_error {
             defmt::error!("t={=u32} reel refused the command: {}", tick, e);
             return Flow::Failed;
