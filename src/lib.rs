@@ -12,6 +12,7 @@ pub mod config;
 pub mod controller;
 pub mod envelope;
 pub mod equilibrium;
+pub mod estimator;
 pub mod fastmath;
 pub mod hal;
 pub mod law;
