@@ -53,8 +53,10 @@
 //! bias is observable only through the gravity-gradient stiffness, over a libration period
 //! (≈ 57 min). This filter therefore estimates d, not b: a bias b makes α̂ read α + b (no
 //! filter on α alone can do better; the law then holds α_r − b), while α̇̂ stays unbiased
-//! because d̂ → κ b takes up the stiffness mismatch. Without d, a 1e-3 rad bias would
-//! put a steady error of about κ b / (filter bandwidth) ≈ 3.4e-9/0.01 ≈ 3e-7 rad/s into α̇̂.
+//! because d̂ → κ b takes up the stiffness mismatch: with a 1e-3 rad bias, in stage 1 of the
+//! paper's mission from 1 h on, α̇̂'s error is 5.7e-8 rad/s RMS with a mean of −1.1e-8; the
+//! same filter without d (its drift and prior at their floors) errs by 3.6e-6 rad/s RMS
+//! (`tests/estimator.rs::a_constant_sensor_bias_leaves_the_rate_unbiased`).
 //!
 //! # Tuning ([`Config::paper`]) and the noise it assumes
 //!
@@ -157,19 +159,18 @@ pub struct Config<T> {
 }
 
 impl<T: Real> Config<T> {
-    /// The tuning for the paper's mission with a swing sensor of σ_α = 1e-4 rad at 1 s, and
-    /// its derivation (see the module docs for what each figure covers):
+    /// The tuning for the paper's mission with a swing sensor of σ_α = 1e-4 rad at 1 s (the
+    /// module docs say what each figure covers):
     ///
-    /// - d's drift: the disturbances it covers change by ~3·10⁻⁹ rad/s² over a quarter orbit
-    ///   (≈ 1 500 s); a random walk of density √q_d reaches √(q_d t) there, so
-    ///   √q_d ≈ 3e-9/√1500 ≈ 8e-11. We take 1e-11 (the walk spans 4e-10 rad/s² in 1 500 s
-    ///   and 1.6e-9 in a day) since d's changes are slow and smooth; a larger value widens the
-    ///   filter (bandwidth ∝ q_d^(1/6)) and its α̇ noise as q_d^(1/4)·σ_α^(1/2)… see the tests.
-    /// - α̈ white noise 1e-9 rad/s² per √Hz: above the f32 rounding of the step (a few 1e-10
-    ///   rad/s² per period), far below d's.
-    /// - At the start, α̇ within 2e-3 rad/s (twice the orbit rate: any swing the law
+    /// - d's drift, 1e-11 rad/s² per √s. The disturbances d stands for change smoothly, by at
+    ///   most ~3e-9 rad/s² over a quarter orbit (≈ 1 500 s). The filter's bandwidth is
+    ///   (q_d/(σ_α² h))^(1/6) ≈ 5e-3 rad/s, a time constant of about 200 s, so it follows them;
+    ///   a larger drift widens it (as q_d^(1/6)) and raises α̇̂'s noise (as q_d^(1/4)).
+    /// - α̈ white noise 1e-9 rad/s² per √Hz, far below d's effect over a period and far above
+    ///   the f32 rounding of α̇̂ (an ulp of 7e-12 rad/s per period).
+    /// - At the start, α̇ within σ = 2e-3 rad/s (twice the orbit rate: any swing the law
     ///   survives) and d within 1e-6 rad/s².
-    /// - The gate: 16 (4σ); 10 consecutive rejections restart α.
+    /// - The gate 16 (4σ); 10 consecutive rejections restart α.
     pub fn paper() -> Self {
         Self {
             period_s: T::ONE,
@@ -184,8 +185,9 @@ impl<T: Real> Config<T> {
         }
     }
 
-    /// Checks every parameter against its admitted range (chosen so that every variance and
-    /// product the filter forms is a normal f32); the first violation is returned.
+    /// Checks every parameter against its admitted range (chosen so that the filter's
+    /// variances and products stay finite and its divisions defined in f32); the first
+    /// violation is returned.
     pub fn validate(&self) -> Result<(), ConfigError> {
         in_range("period_s", self.period_s, 0.05, 10.0)?;
         in_range("alpha_noise_rad", self.alpha_noise_rad, 1e-6, 0.5)?;
@@ -222,15 +224,15 @@ impl<T: Real> Config<T> {
     }
 }
 
-/// `value` in [min, max] (NaN is not), or the error naming `param`.
+/// `value` in [min, max] (NaN is not), or the error naming `param`. The bounds are compared
+/// in `T` (so an f32 configuration may use the bounds themselves).
 fn in_range<T: Real>(param: &'static str, value: T, min: f64, max: f64) -> Result<(), ConfigError> {
-    let v = value.to_f64();
-    if v >= min && v <= max {
+    if value >= T::from_f64(min) && value <= T::from_f64(max) {
         Ok(())
     } else {
         Err(ConfigError {
             param,
-            value: v,
+            value: value.to_f64(),
             min,
             max,
         })
@@ -308,6 +310,7 @@ pub struct DriveError {
 
 /// The estimate and its uncertainty.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub struct Estimate<T> {
     /// α̂, rad.
     pub alpha_rad: T,
@@ -331,6 +334,7 @@ pub struct Estimate<T> {
 
 /// A sample's innovation against the prediction.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub struct Innovation<T> {
     /// ν = z − α̂⁻, rad.
     pub innovation_rad: T,
@@ -358,6 +362,7 @@ pub enum Prediction {
 
 /// What became of this period's α sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub enum Measurement<T> {
     /// Used in the update.
     Accepted(Innovation<T>),
@@ -376,6 +381,7 @@ pub enum Measurement<T> {
 
 /// One period of the estimator, explained.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub struct Output<T> {
     /// The estimate after this period's sample, if there is one.
     pub estimate: Option<Estimate<T>>,
