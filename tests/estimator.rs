@@ -1002,3 +1002,94 @@ fn a_quantised_sensor_is_covered_by_its_quantum() {
     assert!(without > 1.2, "{without}");
     assert!(rate_rms < 1e-7);
 }
+
+#[test]
+fn the_law_flies_the_mission_on_the_estimate_with_a_taut_tether() {
+    // A preview of the wiring (not yet in the controller): the flight controller under the
+    // realistic reel envelope (scenarios/paper-reel-limits.toml: 10 m/s, 0.1 m/s²) fed the
+    // estimate (α̂, α̇̂) from α samples with 1e-4 rad of noise, instead of the true α and α̇.
+    // docs/hazards.md O-5: white α̇ noise of 1e-6 rad/s slackens the tether 69 times. With the
+    // estimate, the tether stays taut after the release transient (O-6: 1 800 s) and the
+    // mission's lengths stay within 0.2 % of the run on the truth.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/paper-reel-limits.toml");
+    let sc = Scenario::load(&path, &[]).expect("scenario loads");
+    let fly_on = |estimated: bool| {
+        let cfg = sim::controller_config::<f32>(&sc).expect("config");
+        let mut ctl = Controller::new(cfg).expect("controller");
+        let plant: Plant = sim::plant(&sc);
+        let mut x: State = sim::initial_state(&sc, &cfg);
+        let mut est = Estimator::<f32>::new(Config::paper()).expect("estimator");
+        let mut rng = Normal::new(29);
+        let mut drive = None;
+        let (mut min_tension, mut slack_ticks, mut lengths) = (f64::INFINITY, 0, Vec::new());
+        let mut keep_error = 0.0_f64;
+        for tick in 0..=72_000u32 {
+            let z = (x[ix::ALPHA] + 1e-4 * rng.sample()) as f32;
+            let (alpha, rate) = if estimated {
+                let d = drive.unwrap_or(Drive {
+                    length_m: x[ix::LENGTH] as f32,
+                    rate_mps: 0.0,
+                    accel_mps2: 0.0,
+                    orbit_rate_radps: N as f32,
+                    mu3: 0.0,
+                });
+                let e = est.step(&d, Some(z)).estimate.expect("an estimate");
+                (e.alpha_rad, e.alpha_rate_radps)
+            } else {
+                (x[ix::ALPHA] as f32, x[ix::ALPHA_RATE] as f32)
+            };
+            let input = Input {
+                tick,
+                length_m: x[ix::LENGTH] as f32,
+                alpha_rad: alpha,
+                alpha_rate_radps: rate,
+                orbit_rate_radps: N as f32,
+            };
+            let out = Stepper::step(&mut ctl, tick, Some(&input)).expect("steps");
+            let (rate, accel) = (f64::from(out.rate_cmd_mps), f64::from(out.accel_cmd_mps2));
+            let tension = plant.tension_n(&x, rate, accel);
+            if tick >= 1_800 {
+                min_tension = min_tension.min(tension);
+                slack_ticks += usize::from(tension <= 0.0);
+            }
+            if tick % 1_800 == 0 {
+                lengths.push(x[ix::LENGTH]);
+            }
+            if (7 * 3_600..8 * 3_600).contains(&tick) {
+                keep_error = keep_error.max((x[ix::LENGTH] - 30_000.0).abs());
+            }
+            drive = Some(Drive {
+                length_m: x[ix::LENGTH] as f32,
+                rate_mps: out.rate_cmd_mps,
+                accel_mps2: 0.0,
+                orbit_rate_radps: N as f32,
+                mu3: 0.0,
+            });
+            x = plant.rk4_step(&x, rate, sc.controller.period_s);
+        }
+        (min_tension, slack_ticks, lengths, keep_error)
+    };
+    let (min_truth, slack_truth, l_truth, keep_truth) = fly_on(false);
+    let (min_est, slack_est, l_est, keep_est) = fly_on(true);
+    // Relative: during the deployment's exponential growth a lag of a fraction of a second
+    // is metres (10.9 m at 3 h, 0.05 %).
+    let worst_dl = l_truth
+        .iter()
+        .zip(&l_est)
+        .map(|(a, b)| (a - b).abs() / a)
+        .fold(0.0, f64::max);
+    eprintln!(
+        "realistic reel, t ≥ 1800 s: on the truth min tension {min_truth:.3} N, {slack_truth} \
+         slack ticks; on the estimate (σ_α = 1e-4 rad) min tension {min_est:.3} N, {slack_est} \
+         slack ticks; lengths every 30 min within {:.3} % of the truth run; |l − 30 km| from 7 h \
+         to 8 h at most {keep_truth:.3} m on the truth, {keep_est:.3} m on the estimate",
+        100.0 * worst_dl
+    );
+    assert_eq!(slack_est, 0);
+    assert!(worst_dl < 2e-3, "{worst_dl}");
+    // The paper's 0.1 m station keeping is not kept on α samples of 1e-4 rad: the estimate's
+    // noise (α̂ ~2e-5 rad, α̇̂ ~4e-8 rad/s, correlated over minutes) moves the 30 km keep by
+    // about a quarter metre (0.26 m; 0.045 m on the truth). A finding for the wiring's tuning:
+    // a d drift of 1e-12 instead of 1e-11 rad/s² per √s keeps it at 0.10 m, 1e-10 at 0.51 m.
+    assert!(keep_est < 0.5, "{keep_est}");
+}
