@@ -99,7 +99,9 @@
 //! above its cap ([`ALPHA_VARIANCE_CAP_RAD2`], the initial α̇ and d variances) is brought back
 //! to the cap by scaling its row and column (D P D with D diagonal, which keeps P positive
 //! semidefinite), so a dropout of any length cannot overflow f32 and ends no less certain than
-//! a fresh start.
+//! a fresh start. Each prediction also grows the variances by [`ROUNDING_LOAD`] of themselves,
+//! the process noise of the f32 rounding: without it a dropout lasting hours takes P to rank
+//! one, where rounding makes it indefinite.
 //!
 //! # Cost
 //!
@@ -116,6 +118,10 @@ use crate::real::Real;
 /// The largest |s h| = |(2 + μ3) l̇/l| h the one-step discretisation admits (see the module
 /// docs: the Taylor series of φ₁ is then accurate to 5·10⁻⁴). The paper's release is 0.2.
 pub const MAX_STRETCH_PER_PERIOD: f64 = 0.5;
+
+/// ε, the relative growth of each variance per period that stands for the rounding of the
+/// covariance propagation (see `Sym3::rounding_loaded`): 2⁻²², four f32 roundings.
+pub const ROUNDING_LOAD: f64 = 1.0 / 4_194_304.0;
 
 /// The cap on α's variance, rad² (1 rad of standard deviation: beyond it α̂ says nothing).
 pub const ALPHA_VARIANCE_CAP_RAD2: f64 = 1.0;
@@ -614,7 +620,11 @@ impl<T: Real> Estimator<T> {
                 h * (T::ONE - stiffness * psi_ad - s * psi_wd),
             ],
         ];
-        let p = t.p.propagated(&phi).plus(&self.process).capped(&self.caps);
+        let p =
+            t.p.propagated(&phi)
+                .rounding_loaded()
+                .plus(&self.process)
+                .capped(&self.caps);
         Ok(Track {
             alpha,
             rate,
@@ -733,6 +743,23 @@ impl<T: Real> Sym3<T> {
             ww: dot(&m1, f1),
             wd: m1[2],
             dd: p.dd,
+        }
+    }
+
+    /// The rounding noise of the period: each variance grown by [`ROUNDING_LOAD`] of itself.
+    ///
+    /// P + ε diag(P) lifts the smallest eigenvalue of P's correlation matrix by about ε each
+    /// period. Without it, a long dropout (d's growing uncertainty drives α and α̇ alike, so P
+    /// tends to rank one: correlations of 0.9999 and beyond) meets the f32 rounding of each
+    /// period (6e-8) and P turns indefinite within a day
+    /// (`tests/estimator.rs::a_dropout_of_days_stays_bounded_in_f32`).
+    fn rounding_loaded(&self) -> Self {
+        let grow = T::ONE + T::from_f64(ROUNDING_LOAD);
+        Self {
+            aa: self.aa * grow,
+            ww: self.ww * grow,
+            dd: self.dd * grow,
+            ..*self
         }
     }
 

@@ -265,6 +265,23 @@ fn nees<T: Real>(e: &Estimate<T>, err: &[f64; 3]) -> f64 {
     x[0] * y[0] + x[1] * y[1] + x[2] * y[2]
 }
 
+/// Whether an estimate's covariance is symmetric positive definite: the leading minors of its
+/// correlation matrix (P scaled to unit diagonal) are positive.
+fn positive_definite<T: Real>(e: &Estimate<T>) -> bool {
+    let p = covariance(e);
+    if !(p[0][0] > 0.0 && p[1][1] > 0.0 && p[2][2] > 0.0) {
+        return false;
+    }
+    let s = [0, 1, 2].map(|i| p[i][i].sqrt());
+    let c = [0, 1, 2].map(|i| [0, 1, 2].map(|j| p[i][j] / (s[i] * s[j])));
+    let minor2 = 1.0 - c[0][1] * c[0][1];
+    let det = 1.0 + 2.0 * c[0][1] * c[1][2] * c[0][2]
+        - c[0][1] * c[0][1]
+        - c[1][2] * c[1][2]
+        - c[0][2] * c[0][2];
+    minor2 > 0.0 && det > 0.0
+}
+
 /// The χ² quantile of `dof` degrees of freedom at the standard-normal quantile `z`
 /// (Wilson–Hilferty; within 0.1 % of the exact value for dof ≥ 50).
 fn chi2_quantile(dof: f64, z: f64) -> f64 {
@@ -283,6 +300,7 @@ fn alpha_rate_error_over_the_paper_mission() {
     let mut prev_err: Option<f64> = None;
     let mut diff2 = 0.0;
     let mut gated = 0;
+    let mut not_pd = 0;
     filter::<f32>(
         Config::paper(),
         flight,
@@ -294,6 +312,7 @@ fn alpha_rate_error_over_the_paper_mission() {
             if matches!(out.measurement, Measurement::Gated(_)) {
                 gated += 1;
             }
+            not_pd += usize::from(!positive_definite(&e));
             let err = error(&e, t)[1];
             if k >= SETTLE_TICKS {
                 sum2 += err * err;
@@ -322,6 +341,8 @@ fn alpha_rate_error_over_the_paper_mission() {
     );
     assert!(rms < 1e-7, "RMS {rms:e}");
     assert!(white < 1e-8, "jitter {white:e}");
+    // The f32 covariance stays positive definite at every one of the 72 001 ticks.
+    assert_eq!(not_pd, 0);
 }
 
 /// Consistency figures of a Monte Carlo: N flights with the process noise of `truth_cfg`, each
@@ -731,6 +752,7 @@ fn a_dropout_of_days_stays_bounded_in_f32() {
         assert!(e.alpha_rate_var_rad2ps2 <= cfg.initial_rate_std_radps.powi(2));
         assert!(e.disturbance_var_rad2ps4 <= cfg.initial_disturbance_std_radps2.powi(2));
         assert!(e.alpha_rad.is_finite() && e.alpha_rate_radps.is_finite());
+        assert!(positive_definite(&e), "{e:?}");
     }
     let e = est.estimate().expect("estimate");
     eprintln!("after two days without samples: {e:?}");
@@ -922,6 +944,7 @@ proptest! {
                 for (v, cap) in vars.iter().zip(&caps) {
                     prop_assert!(*v >= 0.0 && *v <= *cap, "{e:?}");
                 }
+                prop_assert!(positive_definite(&e), "{e:?}");
             }
         }
     }
