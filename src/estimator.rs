@@ -97,9 +97,9 @@
 //! out for H = (1 0 0). Negative rounding residue on the diagonal is cut to zero (adding a
 //! non-negative diagonal keeps P positive semidefinite). After each prediction a variance
 //! above its cap ([`ALPHA_VARIANCE_CAP_RAD2`], the initial α̇ and d variances) is brought back
-//! to the cap by scaling its row and column (D P D with D diagonal, which keeps P positive
-//! semidefinite), so a dropout of any length cannot overflow f32 and ends no less certain than
-//! a fresh start. Each prediction also grows the variances by [`ROUNDING_LOAD`] of themselves,
+//! to the cap, its covariances scaled down with it (a congruence plus a non-negative diagonal,
+//! which keeps P positive semidefinite), so a dropout of any length cannot overflow f32 and
+//! ends no less certain than a fresh start. Each prediction also grows the variances by [`ROUNDING_LOAD`] of themselves,
 //! the process noise of the f32 rounding: without it a dropout lasting hours takes P to rank
 //! one, where rounding makes it indefinite.
 //!
@@ -109,9 +109,10 @@
 //! so Φ P Φᵀ is 30 multiply-adds on the 6 stored entries, and the Joseph update for H = (1 0 0)
 //! is 27; one sin_cos (of 2α̂) and two divisions a step. On the Cortex-M4F
 //! (`examples/bench_estimator.rs`, flight profile, over the paper mission) a step takes 390
-//! instructions with a sample (median and worst), 300 in a dropout and 333 with a gated
-//! sample; nalgebra's general 3×3 forms of the two covariance products alone take 815
-//! (Φ P Φᵀ + Q) and 1 170 (Joseph) at opt-level "s".
+//! instructions with a sample (median; 430 at worst, in the first ticks, where the α̇
+//! variance sits at its cap), 300 in a dropout and 333 with a gated sample; nalgebra's general
+//! 3×3 forms of the two covariance products alone take 815 (Φ P Φᵀ + Q) and 1 170 (Joseph)
+//! at opt-level "s".
 
 use crate::real::Real;
 
@@ -775,30 +776,26 @@ impl<T: Real> Sym3<T> {
         }
     }
 
-    /// Each variance above its cap brought to the cap by scaling its row and column by
-    /// √(cap/var) (D P D, D diagonal: positive semidefinite stays so, correlations unchanged).
+    /// Each variance above its cap brought to the cap, its covariances scaled by r = cap/var
+    /// (no square root): the result is D P D with D = diag(r) (1 where not capped) plus the
+    /// non-negative diagonal that lifts each capped variance from r²·var back to the cap, so
+    /// it stays positive semidefinite, and the capped state's correlations shrink by √r.
     fn capped(&self, caps: &[T; 3]) -> Self {
         if self.aa <= caps[0] && self.ww <= caps[1] && self.dd <= caps[2] {
             return *self;
         }
-        let scale = |var: T, cap: T| {
-            if var > cap {
-                (cap / var).sqrt()
-            } else {
-                T::ONE
-            }
-        };
-        let d = [
-            scale(self.aa, caps[0]),
-            scale(self.ww, caps[1]),
-            scale(self.dd, caps[2]),
+        let ratio = |var: T, cap: T| if var > cap { cap / var } else { T::ONE };
+        let r = [
+            ratio(self.aa, caps[0]),
+            ratio(self.ww, caps[1]),
+            ratio(self.dd, caps[2]),
         ];
         Self {
             aa: self.aa.min(caps[0]),
-            aw: self.aw * d[0] * d[1],
-            ad: self.ad * d[0] * d[2],
+            aw: self.aw * r[0] * r[1],
+            ad: self.ad * r[0] * r[2],
             ww: self.ww.min(caps[1]),
-            wd: self.wd * d[1] * d[2],
+            wd: self.wd * r[1] * r[2],
             dd: self.dd.min(caps[2]),
         }
     }
@@ -1049,10 +1046,10 @@ mod tests {
     }
 
     #[test]
-    fn caps_bound_the_covariance_and_keep_correlations() {
+    fn caps_bound_the_covariance_and_never_raise_a_correlation() {
         let p = Sym3 {
             aa: 4.0,
-            aw: 0.01,
+            aw: 0.0199,
             ad: 1e-6,
             ww: 1e-4,
             wd: 1e-9,
@@ -1061,9 +1058,12 @@ mod tests {
         let caps = [1.0, 4e-6, 1e-12];
         let c = p.capped(&caps);
         assert_eq!((c.aa, c.ww, c.dd), (1.0, 4e-6, 1e-12));
-        let corr = |a: f64, b: f64, ab: f64| ab / (a * b).sqrt();
-        assert!((corr(c.aa, c.ww, c.aw) - corr(p.aa, p.ww, p.aw)).abs() < 1e-12);
-        assert!((corr(c.ww, c.dd, c.wd) - corr(p.ww, p.dd, p.wd)).abs() < 1e-12);
+        let corr = |a: f64, b: f64, ab: f64| (ab / (a * b).sqrt()).abs();
+        assert!(corr(c.aa, c.ww, c.aw) <= corr(p.aa, p.ww, p.aw));
+        assert!(corr(c.aa, c.dd, c.ad) <= corr(p.aa, p.dd, p.ad));
+        assert!(corr(c.ww, c.dd, c.wd) <= corr(p.ww, p.dd, p.wd));
+        // Still positive definite: leading minors of the result.
+        assert!(c.aa * c.ww - c.aw * c.aw > 0.0);
         assert_eq!(p.capped(&[10.0, 1.0, 1.0]), p);
     }
 
