@@ -1032,8 +1032,9 @@ fn the_law_flies_the_mission_on_the_estimate_with_a_taut_tether() {
     // realistic reel envelope (scenarios/paper-reel-limits.toml: 10 m/s, 0.1 m/s²) fed the
     // estimate (α̂, α̇̂) from α samples with 1e-4 rad of noise, instead of the true α and α̇.
     // docs/hazards.md O-5: white α̇ noise of 1e-6 rad/s slackens the tether 69 times. With the
-    // estimate, the tether stays taut after the release transient (O-6: 1 800 s) and the
-    // mission's lengths stay within 0.2 % of the run on the truth.
+    // estimate, the tether stays taut all mission long (as on the truth; its margin after
+    // 1 800 s is 2 mN on both, O-6's thin start) and the mission's lengths stay within 0.2 % of
+    // the run on the truth.
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/paper-reel-limits.toml");
     let sc = Scenario::load(&path, &[]).expect("scenario loads");
     let fly_on = |estimated: bool| {
@@ -1046,6 +1047,7 @@ fn the_law_flies_the_mission_on_the_estimate_with_a_taut_tether() {
         let mut drive = None;
         let (mut min_tension, mut slack_ticks, mut lengths) = (f64::INFINITY, 0, Vec::new());
         let mut keep_error = 0.0_f64;
+        let mut early_slack = 0;
         for tick in 0..=72_000u32 {
             let z = (x[ix::ALPHA] + 1e-4 * rng.sample()) as f32;
             let (alpha, rate) = if estimated {
@@ -1074,6 +1076,8 @@ fn the_law_flies_the_mission_on_the_estimate_with_a_taut_tether() {
             if tick >= 1_800 {
                 min_tension = min_tension.min(tension);
                 slack_ticks += usize::from(tension <= 0.0);
+            } else {
+                early_slack += usize::from(tension <= 0.0);
             }
             if tick % 1_800 == 0 {
                 lengths.push(x[ix::LENGTH]);
@@ -1090,10 +1094,10 @@ fn the_law_flies_the_mission_on_the_estimate_with_a_taut_tether() {
             });
             x = plant.rk4_step(&x, rate, sc.controller.period_s);
         }
-        (min_tension, slack_ticks, lengths, keep_error)
+        (min_tension, slack_ticks, lengths, keep_error, early_slack)
     };
-    let (min_truth, slack_truth, l_truth, keep_truth) = fly_on(false);
-    let (min_est, slack_est, l_est, keep_est) = fly_on(true);
+    let (min_truth, slack_truth, l_truth, keep_truth, early_truth) = fly_on(false);
+    let (min_est, slack_est, l_est, keep_est, early_est) = fly_on(true);
     // Relative: during the deployment's exponential growth a lag of a fraction of a second
     // is metres (10.9 m at 3 h, 0.05 %).
     let worst_dl = l_truth
@@ -1105,10 +1109,11 @@ fn the_law_flies_the_mission_on_the_estimate_with_a_taut_tether() {
         "realistic reel, t ≥ 1800 s: on the truth min tension {min_truth:.3} N, {slack_truth} \
          slack ticks; on the estimate (σ_α = 1e-4 rad) min tension {min_est:.3} N, {slack_est} \
          slack ticks; lengths every 30 min within {:.3} % of the truth run; |l − 30 km| from 7 h \
-         to 8 h at most {keep_truth:.3} m on the truth, {keep_est:.3} m on the estimate",
+         to 8 h at most {keep_truth:.3} m on the truth, {keep_est:.3} m on the estimate; slack \
+         ticks before 1800 s: {early_truth} on the truth, {early_est} on the estimate",
         100.0 * worst_dl
     );
-    assert_eq!(slack_est, 0);
+    assert_eq!((early_est, slack_est), (0, 0));
     assert!(worst_dl < 2e-3, "{worst_dl}");
     // The paper's 0.1 m station keeping is not kept on α samples of 1e-4 rad: the estimate's
     // noise (α̂ ~2e-5 rad, α̇̂ ~4e-8 rad/s, correlated over minutes) moves the 30 km keep by
