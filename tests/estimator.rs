@@ -826,6 +826,56 @@ fn one_period_matches_the_plant() {
 }
 
 #[test]
+fn the_discretisation_error_against_the_period() {
+    // One prediction over periods of 1 to 10 s against the plant integrated in 1 ms RK4 steps,
+    // from the early deployment (l = 100 m, l̇ = 2 m/s: |s h| = 0.04 … 0.4) and the 9 km
+    // deployment (l̇ = 1.5 m/s): the error grows as h³ (the midpoint rule for s and the
+    // local-linearisation step are second order).
+    let sc = paper_scenario();
+    let plant: Plant = sim::plant(&sc);
+    for (l, v, alpha, rate) in [(100.0, 2.0, -0.9, -6e-4), (9_000.0, 1.5, -0.78, 2e-5)] {
+        let mut previous: Option<(f64, f64, f64)> = None;
+        for h in [1.0, 2.0, 5.0, 10.0] {
+            let cfg = Config {
+                period_s: h,
+                ..Config::<f64>::paper()
+            };
+            let mut est = Estimator::new(cfg).expect("valid");
+            est.initialise(alpha, rate).expect("a state");
+            let drive = Drive {
+                length_m: l,
+                rate_mps: v,
+                accel_mps2: 0.0,
+                orbit_rate_radps: N,
+                mu3: 0.0,
+            };
+            let e = est.step(&drive, None).estimate.expect("predicted");
+            let mut x = State::from([0.0, l, alpha, rate, 0.0, 0.0]);
+            let steps = (h * 1_000.0).round() as u32;
+            for _ in 0..steps {
+                x = plant.rk4_step(&x, v, h / f64::from(steps));
+            }
+            let da = (e.alpha_rad - x[ix::ALPHA]).abs();
+            let dw = (e.alpha_rate_radps - x[ix::ALPHA_RATE]).abs();
+            eprintln!(
+                "h = {h:4} s at l = {l} m, l̇ = {v} m/s: α error {da:9.2e} rad, α̇ error {dw:9.2e} \
+                 rad/s"
+            );
+            if h == 1.0 {
+                assert!(da < 1e-7 && dw < 1e-9, "{da:e} {dw:e}");
+            }
+            if let Some((h0, da0, dw0)) = previous {
+                // No faster than cubic growth (a margin of 2 for the series' higher terms).
+                let cubic = 2.0 * (h / h0).powi(3);
+                assert!(da <= cubic * da0 + 1e-12, "{da:e} after {da0:e}");
+                assert!(dw <= cubic * dw0 + 1e-15, "{dw:e} after {dw0:e}");
+            }
+            previous = Some((h, da, dw));
+        }
+    }
+}
+
+#[test]
 fn a_constant_sensor_bias_leaves_the_rate_unbiased() {
     // A 1e-3 rad α bias: α̂ reads α + b (unobservable from α alone, see the module docs), while
     // d̂ absorbs the stiffness mismatch and α̇̂ keeps its accuracy. The same filter without its
