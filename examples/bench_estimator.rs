@@ -207,6 +207,9 @@ mod bench {
             rate_mps: now[0] - before[0],
             accel_mps2: 0.0,
             orbit_rate_radps: crate::mission::ORBIT_RATE_RADPS,
+            orbit_accel_radps2: 0.0,
+            gravity_gradient_per_s2: crate::mission::ORBIT_RATE_RADPS
+                * crate::mission::ORBIT_RATE_RADPS,
             mu3: 0.0,
         })
     }

@@ -5,17 +5,18 @@
 //! # Model
 //!
 //! State x = (α, α̇, d): the in-plane angle, its rate, and d, an unmodelled angular
-//! acceleration (a disturbance torque per unit inertia). Between samples, on a circular orbit
-//! (θ̇ = n, θ̈ = 0, μ/R³ = n²), Eq. 5b reads
+//! acceleration (a disturbance torque per unit inertia). Between samples, in the orbit plane
+//! (β = 0), Eq. 5b reads
 //!
 //! ```text
-//!   α̈ = −(n + α̇) s(t) − 1.5 n² sin 2α + d,     s = (2 + μ3) l̇/l,     ḋ = white noise,
+//!   α̈ = −(θ̇ + α̇) s(t) − (3μ/(2R³)) sin 2α − θ̈ + d,    s = (2 + μ3) l̇/l,    ḋ = white noise,
 //! ```
 //!
-//! driven by the reel's known rate and acceleration ([`Drive`]); α̈ also receives white
-//! noise. d absorbs what the model leaves out: the eccentric orbit's θ̈ and its varying μ/R³,
-//! out-of-plane coupling (2β̇ tanβ terms), tether elasticity, errors of the reel's rate or
-//! length, and an α-sensor bias (see *Observability*).
+//! driven by the reel's known rate and acceleration and the orbit's θ̇, θ̈ and μ/R³ ([`Drive`];
+//! n, 0 and n² on a circular orbit, where it is Eq. 26's −(n + α̇) s − 1.5 n² sin 2α); α̈ also
+//! receives white noise. d absorbs what the model leaves out: out-of-plane coupling (2β̇ tanβ
+//! terms), tether elasticity, errors of the reel's rate or length or of the orbit's terms, and
+//! an α-sensor bias (see *Observability*).
 //!
 //! # Discretisation (one control period h)
 //!
@@ -25,7 +26,7 @@
 //!
 //! ```text
 //!       [  0    1   0 ]
-//!   A = [ −κ   −s   1 ],    κ = 3 n² cos 2α̂ (the gravity-gradient stiffness),
+//!   A = [ −κ   −s   1 ],    κ = (3μ/R³) cos 2α̂ (the gravity-gradient stiffness),
 //!       [  0    0   0 ]
 //! ```
 //!
@@ -66,9 +67,11 @@
 //!   q²/12 to R).
 //! - d drifts as a random walk of density 1e-11 rad/s² per √s: it spans 4e-10 rad/s² in a
 //!   quarter orbit and 3e-9 rad/s² in a day. That covers, as slowly varying accelerations, a
-//!   1e-3 rad α bias seen through κ (≤ 3n² b = 3.4e-9 rad/s²), an eccentricity up to 1e-3
-//!   (θ̈ ≤ 2e n² = 2.2e-9 rad/s², at orbital frequency) and a 1 mm/s reel-rate error at 9 km
-//!   (2n δl̇/l = 2.4e-10 rad/s²). The filter's bandwidth grows as q_d^(1/6), its α̇ noise
+//!   1e-3 rad α bias seen through κ (≤ 3n² b = 3.4e-9 rad/s²) and a 1 mm/s reel-rate error
+//!   at 9 km (2n δl̇/l = 2.4e-10 rad/s²). It does not cover an eccentric orbit flown on the
+//!   circular model: at e = 1e-3 (θ̈ up to 2e n² = 2.2e-9 rad/s², at orbital frequency) α̇̂
+//!   errs by 1.7e-7 rad/s RMS in stage 1, 3.1e-8 with the true θ̈ and μ/R³ in the [`Drive`]
+//!   (`tests/estimator.rs::an_eccentric_orbit_needs_its_orbit_terms_in_the_drive`). The filter's bandwidth grows as q_d^(1/6), its α̇ noise
 //!   roughly as q_d^(1/4): a faster drift buys tracking with noise.
 //! - α̈ white noise of density 1e-9 rad/s² per √Hz: above the f32 rounding of one step.
 //! - At the start, α̇ within σ = 2e-3 rad/s (twice the orbit rate: any swing the law
@@ -110,9 +113,9 @@
 //! Plain scalars on the structure, not nalgebra matrices: Φ's d row is e₃ᵀ and P is symmetric,
 //! so Φ P Φᵀ is 30 multiply-adds on the 6 stored entries, and the Joseph update for H = (1 0 0)
 //! is 27; one sin_cos (of 2α̂) and two divisions a step. On the Cortex-M4F
-//! (`examples/bench_estimator.rs`, flight profile, over the paper mission) a step takes 390
-//! instructions with a sample (median; 430 at worst, in the first ticks, where the α̇
-//! variance sits at its cap), 300 in a dropout and 333 with a gated sample; nalgebra's general
+//! (`examples/bench_estimator.rs`, flight profile, over the paper mission) a step takes 408
+//! instructions with a sample (median; 445 at worst, in the first ticks, where the α̇
+//! variance sits at its cap), 318 in a dropout and 348 with a gated sample; nalgebra's general
 //! 3×3 forms of the two covariance products alone take 815 (Φ P Φᵀ + Q) and 1 170 (Joseph)
 //! at opt-level "s".
 
@@ -282,8 +285,12 @@ pub struct Drive<T> {
     pub rate_mps: T,
     /// l̈ over the period, m/s² (0 for a rate held over the period).
     pub accel_mps2: T,
-    /// The orbit rate n, rad/s.
+    /// The orbit rate θ̇, rad/s (n on a circular orbit).
     pub orbit_rate_radps: T,
+    /// The orbit's angular acceleration θ̈, rad/s² (0 on a circular orbit).
+    pub orbit_accel_radps2: T,
+    /// The gravity gradient μ/R³, 1/s² (n² on a circular orbit).
+    pub gravity_gradient_per_s2: T,
     /// μ3 at this length (Eq. 5; 0 for a massless tether).
     pub mu3: T,
 }
@@ -300,6 +307,10 @@ pub enum DriveInput {
     Accel,
     /// `orbit_rate_radps`: not in (0, [`MAX_ORBIT_RATE_RADPS`]].
     OrbitRate,
+    /// `orbit_accel_radps2`: |θ̈| above [`MAX_ORBIT_RATE_RADPS`]² or not finite.
+    OrbitAccel,
+    /// `gravity_gradient_per_s2`: not in (0, [`MAX_ORBIT_RATE_RADPS`]²].
+    GravityGradient,
     /// `mu3`: |μ3| > [`MAX_MU3`] or not finite.
     Mu3,
     /// |(2 + μ3) l̇/l| h at mid-period above [`MAX_STRETCH_PER_PERIOD`] (or the length at
@@ -427,8 +438,10 @@ struct Track<T> {
 /// ```
 /// use tss_reel::estimator::{Config, Drive, Estimator, Measurement};
 /// let mut est = Estimator::<f32>::new(Config::paper()).unwrap();
+/// let n = 1.06e-3; // a circular orbit: θ̇ = n, θ̈ = 0, μ/R³ = n²
 /// let drive = Drive { length_m: 9_000.0, rate_mps: 1.0, accel_mps2: 0.0,
-///                     orbit_rate_radps: 1.06e-3, mu3: 0.0 };
+///                     orbit_rate_radps: n, orbit_accel_radps2: 0.0,
+///                     gravity_gradient_per_s2: n * n, mu3: 0.0 };
 /// let out = est.step(&drive, Some(-0.78));
 /// assert_eq!(out.measurement, Measurement::Initialised);
 /// let out = est.step(&drive, Some(-0.78));
@@ -572,10 +585,15 @@ impl<T: Real> Estimator<T> {
         let length_mid = l + (v + f(0.5) * a * half_h) * half_h;
         let s = (f(2.0) + mu3) * rate_mid / length_mid;
         let u = s * h;
+        let orbit_max = f(MAX_ORBIT_RATE_RADPS);
+        let gradient = drive.gravity_gradient_per_s2;
         let inputs_in_range = l > T::ZERO
             && l <= f(MAX_LENGTH_M)
             && n > T::ZERO
-            && n <= f(MAX_ORBIT_RATE_RADPS)
+            && n <= orbit_max
+            && drive.orbit_accel_radps2.abs() <= orbit_max * orbit_max
+            && gradient > T::ZERO
+            && gradient <= orbit_max * orbit_max
             && mu3.abs() <= f(MAX_MU3);
         if inputs_in_range && length_mid > T::ZERO && u.abs() <= f(MAX_STRETCH_PER_PERIOD) {
             Ok(s)
@@ -589,12 +607,13 @@ impl<T: Real> Estimator<T> {
         let f = T::from_f64;
         let s = self.stretch(drive).map_err(Prediction::InvalidDrive)?;
         let h = self.config.period_s;
-        let n = drive.orbit_rate_radps;
-        let gradient = f(1.5) * n * n;
+        // 3μ/(2R³), and κ = (3μ/R³) cos 2α̂.
+        let gradient = f(1.5) * drive.gravity_gradient_per_s2;
         let (sin2a, cos2a) = (f(2.0) * t.alpha).sin_cos();
-        let stiffness = f(2.0) * gradient * cos2a; // κ = 3n² cos 2α̂
-                                                   // Eq. 5b at the estimate: f(x) = (α̇, α̈, 0).
-        let accel = -(n + t.rate) * s - gradient * sin2a + t.disturbance;
+        let stiffness = f(2.0) * gradient * cos2a;
+        // Eq. 5b at the estimate: f(x) = (α̇, α̈, 0).
+        let spin = drive.orbit_rate_radps + t.rate;
+        let accel = -spin * s - gradient * sin2a - drive.orbit_accel_radps2 + t.disturbance;
         // Ψ = φ₁(Ah) = I + Ah/2 + (Ah)²/6 + (Ah)³/24, its α and α̇ rows (its d row is e₃ᵀ,
         // and Ψ_α̇d = Ψ_αα̇), with u = s h and k = κ h²; Ψ_α̇α enters as hΨ_α̇α (dimensionless).
         let u = s * h;
@@ -694,6 +713,14 @@ fn refusal<T: Real>(drive: &Drive<T>, u: T) -> DriveError {
         (DriveInput::Accel, drive.accel_mps2)
     } else if !(n > T::ZERO && n <= f(MAX_ORBIT_RATE_RADPS)) {
         (DriveInput::OrbitRate, n)
+    } else if drive.orbit_accel_radps2.is_nan()
+        || drive.orbit_accel_radps2.abs() > f(MAX_ORBIT_RATE_RADPS).sq()
+    {
+        (DriveInput::OrbitAccel, drive.orbit_accel_radps2)
+    } else if !(drive.gravity_gradient_per_s2 > T::ZERO
+        && drive.gravity_gradient_per_s2 <= f(MAX_ORBIT_RATE_RADPS).sq())
+    {
+        (DriveInput::GravityGradient, drive.gravity_gradient_per_s2)
     } else if mu3.is_nan() || mu3.abs() > f(MAX_MU3) {
         (DriveInput::Mu3, mu3)
     } else {
@@ -838,6 +865,8 @@ mod tests {
             rate_mps,
             accel_mps2: 0.0,
             orbit_rate_radps: N,
+            orbit_accel_radps2: 0.0,
+            gravity_gradient_per_s2: N * N,
             mu3: 0.0,
         }
     }
@@ -910,6 +939,20 @@ mod tests {
                     ..good
                 },
                 DriveInput::OrbitRate,
+            ),
+            (
+                Drive {
+                    orbit_accel_radps2: f64::NAN,
+                    ..good
+                },
+                DriveInput::OrbitAccel,
+            ),
+            (
+                Drive {
+                    gravity_gradient_per_s2: -1e-6,
+                    ..good
+                },
+                DriveInput::GravityGradient,
             ),
             (Drive { mu3: -3.0, ..good }, DriveInput::Mu3),
             (

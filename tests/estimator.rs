@@ -41,6 +41,12 @@ struct Tick {
     disturbance_radps2: f64,
     /// The rate command held over the period after the tick, m/s.
     rate_cmd_mps: f64,
+    /// The orbit rate θ̇ at the tick, rad/s (n on the paper's circular orbit).
+    orbit_rate_radps: f64,
+    /// θ̈ at the tick, rad/s² (0 on a circular orbit).
+    orbit_accel_radps2: f64,
+    /// μ/R³ at the tick, 1/s² (n² on a circular orbit).
+    gravity_gradient_per_s2: f64,
 }
 
 impl Tick {
@@ -50,7 +56,9 @@ impl Tick {
             length_m: T::from_f64(self.length_m),
             rate_mps: T::from_f64(self.rate_cmd_mps),
             accel_mps2: T::ZERO,
-            orbit_rate_radps: T::from_f64(N),
+            orbit_rate_radps: T::from_f64(self.orbit_rate_radps),
+            orbit_accel_radps2: T::from_f64(self.orbit_accel_radps2),
+            gravity_gradient_per_s2: T::from_f64(self.gravity_gradient_per_s2),
             mu3: T::ZERO,
         }
     }
@@ -137,11 +145,15 @@ fn paper_scenario() -> Scenario {
 /// disturbance the filter's Q describes (a random-walk angular acceleration d and white noise
 /// on α̈, sampled from Q and added between plant steps), seeded by `seed`.
 fn fly(duration_s: f64, process: Option<(&Config<f64>, u64)>) -> Vec<Tick> {
-    let sc = paper_scenario();
-    let cfg = sim::controller_config::<f32>(&sc).expect("paper config");
+    fly_scenario(&paper_scenario(), duration_s, process)
+}
+
+/// [`fly`] for any scenario (its orbit, masses and controller; the ideal reel).
+fn fly_scenario(sc: &Scenario, duration_s: f64, process: Option<(&Config<f64>, u64)>) -> Vec<Tick> {
+    let cfg = sim::controller_config::<f32>(sc).expect("paper config");
     let mut ctl = Controller::new(cfg).expect("valid controller");
-    let plant: Plant = sim::plant(&sc);
-    let mut x: State = sim::initial_state(&sc, &cfg);
+    let plant: Plant = sim::plant(sc);
+    let mut x: State = sim::initial_state(sc, &cfg);
     let h = sc.controller.period_s;
     let total = (duration_s / h).round() as u32;
     let factor = process.map(|(c, _)| process_noise_factor(c));
@@ -155,12 +167,13 @@ fn fly(duration_s: f64, process: Option<(&Config<f64>, u64)>) -> Vec<Tick> {
     };
     let mut ticks = Vec::with_capacity(total as usize + 1);
     for tick in 0..=total {
+        let orbit_rate = plant.orbit_rate_radps(x[ix::THETA]);
         let input = Input {
             tick,
             length_m: x[ix::LENGTH] as f32,
             alpha_rad: x[ix::ALPHA] as f32,
             alpha_rate_radps: x[ix::ALPHA_RATE] as f32,
-            orbit_rate_radps: N as f32,
+            orbit_rate_radps: orbit_rate as f32,
         };
         let out = Stepper::step(&mut ctl, tick, Some(&input)).expect("controller steps");
         let rate = f64::from(out.rate_cmd_mps);
@@ -170,6 +183,9 @@ fn fly(duration_s: f64, process: Option<(&Config<f64>, u64)>) -> Vec<Tick> {
             alpha_rate_radps: x[ix::ALPHA_RATE],
             disturbance_radps2: d,
             rate_cmd_mps: rate,
+            orbit_rate_radps: orbit_rate,
+            orbit_accel_radps2: plant.orbit.true_anomaly_accel_radps2(x[ix::THETA]),
+            gravity_gradient_per_s2: plant.orbit.gravity_gradient_per_s2(x[ix::THETA]),
         });
         x = plant.rk4_step(&x, rate, h);
         if let Some(l) = &factor {
@@ -744,6 +760,8 @@ fn a_dropout_of_days_stays_bounded_in_f32() {
         rate_mps: 0.0,
         accel_mps2: 0.0,
         orbit_rate_radps: N as f32,
+        orbit_accel_radps2: 0.0,
+        gravity_gradient_per_s2: (N * N) as f32,
         mu3: 0.0,
     };
     est.step(&keep, Some(0.01));
@@ -792,6 +810,8 @@ fn one_period_matches_the_plant() {
             rate_mps: v,
             accel_mps2: 0.0,
             orbit_rate_radps: N,
+            orbit_accel_radps2: 0.0,
+            gravity_gradient_per_s2: N * N,
             mu3: 0.0,
         };
         let e = est.step(&drive, None).estimate.expect("predicted");
@@ -850,6 +870,8 @@ fn the_discretisation_error_against_the_period() {
                 rate_mps: v,
                 accel_mps2: 0.0,
                 orbit_rate_radps: N,
+                orbit_accel_radps2: 0.0,
+                gravity_gradient_per_s2: N * N,
                 mu3: 0.0,
             };
             let e = est.step(&drive, None).estimate.expect("predicted");
@@ -876,6 +898,49 @@ fn the_discretisation_error_against_the_period() {
             previous = Some((h, da, dw));
         }
     }
+}
+
+#[test]
+fn an_eccentric_orbit_needs_its_orbit_terms_in_the_drive() {
+    // The paper's mission (stage 1) on an orbit of eccentricity 1e-3, the drive giving the
+    // true θ̇, θ̈ and μ/R³: α̇̂ keeps its circular-orbit accuracy. Given the circular model's
+    // terms instead (θ̈ = 0, μ/R³ = θ̇²: θ̈ up to 2e θ̇² = 2.2e-9 rad/s² left to d), its error
+    // grows several times.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/paper.toml");
+    let sc = Scenario::load(&path, &["orbit.eccentricity=1e-3".to_string()]).expect("loads");
+    let flight = fly_scenario(&sc, 28_800.0, None);
+    let circular: Vec<Tick> = flight
+        .iter()
+        .map(|t| Tick {
+            orbit_accel_radps2: 0.0,
+            gravity_gradient_per_s2: t.orbit_rate_radps * t.orbit_rate_radps,
+            ..*t
+        })
+        .collect();
+    let run = |ticks: &[Tick]| {
+        let (mut sum2, mut n) = (0.0, 0.0);
+        filter::<f64>(
+            Config::paper(),
+            ticks,
+            1e-4,
+            31,
+            &mut |_, z| Some(z),
+            &mut |k, t, o| {
+                if k >= 3_600 {
+                    sum2 += error(&o.estimate.expect("estimate"), t)[1].powi(2);
+                    n += 1.0;
+                }
+            },
+        );
+        (sum2 / n).sqrt()
+    };
+    let (exact, approximate) = (run(&flight), run(&circular));
+    eprintln!(
+        "eccentricity 1e-3, stage 1 from 1 h: α̇ error RMS {exact:.2e} rad/s with θ̈ and μ/R³ \
+         in the drive, {approximate:.2e} rad/s with the circular model's"
+    );
+    assert!(exact < 1e-7, "{exact:e}");
+    assert!(approximate > 2.0 * exact, "{approximate:e}");
 }
 
 #[test]
@@ -933,28 +998,31 @@ fn field(lo: f32, hi: f32) -> impl Strategy<Value = f32> {
 
 /// One period's input: the drive and the sample (or a dropout).
 fn period() -> impl Strategy<Value = (Drive<f32>, Option<f32>)> {
+    let orbit = (
+        field(1.0e-3, 1.2e-3),
+        prop_oneof![Just(0.0_f32), field(-3e-9, 3e-9)],
+        field(1.0e-6, 1.5e-6),
+    );
     (
         field(0.5, 40_000.0),
         field(-15.0, 15.0),
         prop_oneof![Just(0.0_f32), field(-1.0, 1.0)],
-        field(1.0e-3, 1.2e-3),
+        orbit,
         prop_oneof![Just(0.0_f32), field(-0.1, 0.1)],
         proptest::option::weighted(0.9, field(-1.6, 1.6)),
     )
-        .prop_map(
-            |(length_m, rate_mps, accel_mps2, orbit_rate_radps, mu3, z)| {
-                (
-                    Drive {
-                        length_m,
-                        rate_mps,
-                        accel_mps2,
-                        orbit_rate_radps,
-                        mu3,
-                    },
-                    z,
-                )
-            },
-        )
+        .prop_map(|(length_m, rate_mps, accel_mps2, orbit, mu3, z)| {
+            let drive = Drive {
+                length_m,
+                rate_mps,
+                accel_mps2,
+                orbit_rate_radps: orbit.0,
+                orbit_accel_radps2: orbit.1,
+                gravity_gradient_per_s2: orbit.2,
+                mu3,
+            };
+            (drive, z)
+        })
 }
 
 proptest! {
@@ -1022,7 +1090,8 @@ proptest! {
         match Estimator::new(cfg) {
             Ok(mut est) => {
                 let d = Drive { length_m: 9_000.0, rate_mps: 1.0, accel_mps2: 0.0,
-                                orbit_rate_radps: 1.06e-3, mu3: 0.0 };
+                                orbit_rate_radps: 1.06e-3, orbit_accel_radps2: 0.0,
+                                gravity_gradient_per_s2: 1.1236e-6, mu3: 0.0 };
                 for _ in 0..10 {
                     let out = est.step(&d, Some(-0.78));
                     let e = out.estimate.expect("estimate");
@@ -1109,6 +1178,8 @@ fn the_law_flies_the_mission_on_the_estimate_with_a_taut_tether() {
                     rate_mps: 0.0,
                     accel_mps2: 0.0,
                     orbit_rate_radps: N as f32,
+                    orbit_accel_radps2: 0.0,
+                    gravity_gradient_per_s2: (N * N) as f32,
                     mu3: 0.0,
                 });
                 let e = est.step(&d, Some(z)).estimate.expect("an estimate");
@@ -1143,6 +1214,8 @@ fn the_law_flies_the_mission_on_the_estimate_with_a_taut_tether() {
                 rate_mps: out.rate_cmd_mps,
                 accel_mps2: 0.0,
                 orbit_rate_radps: N as f32,
+                orbit_accel_radps2: 0.0,
+                gravity_gradient_per_s2: (N * N) as f32,
                 mu3: 0.0,
             });
             x = plant.rk4_step(&x, rate, sc.controller.period_s);
