@@ -136,8 +136,8 @@ pub const ALPHA_VARIANCE_CAP_RAD2: f64 = 1.0;
 /// the estimate has diverged: [`Prediction::Diverged`]).
 pub const MAX_ALPHA_RATE_RADPS: f64 = 1.0;
 
-/// The largest orbit rate n a drive may give, rad/s (a 10⁻² rad/s orbit would be inside the
-/// Earth; the bound keeps 3n²h² small for the discretisation).
+/// The largest orbit rate θ̇ a drive may give, rad/s (a 10⁻² rad/s orbit would be inside the
+/// Earth); its square bounds |θ̈| and μ/R³, which keeps 3(μ/R³)h² small for the discretisation.
 pub const MAX_ORBIT_RATE_RADPS: f64 = 1e-2;
 
 /// The longest tether a drive may give, m (a thousand kilometres: any real tether).
