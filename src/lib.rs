@@ -112,6 +112,7 @@ pub mod config;
 pub mod controller;
 pub mod envelope;
 pub mod equilibrium;
+pub mod estimator;
 pub mod fastmath;
 #[cfg(all(feature = "firmware", target_os = "none"))]
 pub mod firmware;
