@@ -15,7 +15,7 @@
 //! Build and run it (in the style of `scripts/bench-target`, which times `bench_step`):
 //!
 //! ```text
-//! cargo build --profile firmware --target thumbv7em-none-eabihf --example bench_estimator
+//! cargo build --profile firmware --target thumbv7em-none-eabihf --features firmware --example bench_estimator
 //! TSS_LOG_FORMAT='{L} {s}' TSS_QEMU_ICOUNT='shift=0,align=off,sleep=off' TSS_QEMU_TIMEOUT=900 \
 //!   scripts/qemu-run target/thumbv7em-none-eabihf/firmware/examples/bench_estimator
 //! ```
@@ -27,31 +27,14 @@
 //! Instructions, not cycles (a VDIV takes 14 cycles on silicon).
 //!
 //! On the host this file compiles to an empty program.
-#![cfg_attr(target_os = "none", no_std, no_main)]
+#![no_std]
+#![no_main]
 #![deny(unsafe_code)]
 
-/// Host stub: the benchmark runs only on the target (see the crate docs).
-#[cfg(not(target_os = "none"))]
-fn main() {}
-
-// The global logger and the panic handler, as in the firmware.
-#[cfg(target_os = "none")]
-use defmt_semihosting as _;
-#[cfg(target_os = "none")]
-use panic_probe as _;
-
-/// The firmware's exits and fault handlers (HardFault => failing exit), shared file.
-#[cfg(target_os = "none")]
-#[path = "../src/firmware/exit.rs"]
-mod exit;
-
+use tss_reel::firmware::exit;
 /// The whole paper mission, recorded every 5 s, interpolated to 1 s.
-#[cfg(target_os = "none")]
-#[allow(dead_code)]
-#[path = "bench_step/mission.rs"]
-mod mission;
+use tss_reel::recordings::mission;
 
-#[cfg(target_os = "none")]
 mod bench {
     use core::hint::black_box;
     use cortex_m::peripheral::{syst::SystClkSource, SYST};
@@ -294,7 +277,6 @@ mod bench {
     }
 }
 
-#[cfg(target_os = "none")]
 #[cortex_m_rt::entry]
 fn main() -> ! {
     use bench::{Meter, INSTRUCTIONS_PER_COUNT, K};
