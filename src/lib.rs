@@ -20,6 +20,7 @@ pub mod mass;
 pub mod monitor;
 pub mod orbit;
 pub mod real;
+pub mod reel_drive;
 pub mod schedule;
 pub mod stability;
 
