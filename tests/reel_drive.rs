@@ -586,7 +586,8 @@ fn the_length_is_the_integer_count_to_within_a_count() {
 fn every_invalid_parameter_is_named() {
     let ok = DriveConfig::example();
     assert_eq!(ok.validate(), Ok(()));
-    let cases: [(&str, DriveRule, fn(&mut DriveConfig)); 12] = [
+    type Breaker = fn(&mut DriveConfig);
+    let cases: [(&str, DriveRule, Breaker); 12] = [
         ("inner_rate_hz", DriveRule::BelowMinimum, |c| {
             c.inner_rate_hz = 50
         }),

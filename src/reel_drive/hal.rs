@@ -63,7 +63,6 @@ pub struct MotorPins<M, D, B, E> {
 
 /// An output that refused a write.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub enum ActuatorError {
     /// The PWM channel.
     Pwm(embedded_hal::pwm::ErrorKind),
@@ -73,6 +72,21 @@ pub enum ActuatorError {
     Brake(embedded_hal::digital::ErrorKind),
     /// The enable pin.
     Enable(embedded_hal::digital::ErrorKind),
+}
+
+// embedded-hal's kinds implement defmt 0.3's `Format` only (its `defmt-03` feature), not
+// defmt 1's: they are logged through their `Debug`.
+#[cfg(target_os = "none")]
+impl defmt::Format for ActuatorError {
+    fn format(&self, f: defmt::Formatter) {
+        use defmt::Debug2Format as D;
+        match self {
+            Self::Pwm(k) => defmt::write!(f, "Pwm({})", D(k)),
+            Self::Direction(k) => defmt::write!(f, "Direction({})", D(k)),
+            Self::Brake(k) => defmt::write!(f, "Brake({})", D(k)),
+            Self::Enable(k) => defmt::write!(f, "Enable({})", D(k)),
+        }
+    }
 }
 
 /// What one tick of the driver did besides stepping the speed loop (whose output is
