@@ -54,10 +54,9 @@ pub struct Odometer {
     window: usize,
     /// The last accepted raw counter value; `None` before the first reading.
     last_raw: Option<u32>,
+    /// The accepted readings, newest at `newest`; the first reading fills every slot, so the
+    /// window always has a start (no count of valid entries to keep).
     history: [Sample; HISTORY],
-    /// Samples in `history` (saturates at `HISTORY`).
-    len: usize,
-    /// Index of the newest sample.
     newest: usize,
 }
 
@@ -73,7 +72,6 @@ impl Odometer {
             window: cfg.speed_window_ticks as usize,
             last_raw: None,
             history: [Sample::default(); HISTORY],
-            len: 0,
             newest: 0,
         }
     }
@@ -82,37 +80,41 @@ impl Odometer {
     /// speed loop checks that before it calls this). The first reading sets the origin.
     pub fn update(&mut self, tick: u32, raw: Option<u32>) -> Result<(), CountFault> {
         let raw = raw.ok_or(CountFault::Missing)?;
-        let (Some(last_raw), Some(last)) = (self.last_raw, self.newest_sample()) else {
+        let Some(last_raw) = self.last_raw else {
             self.last_raw = Some(raw);
-            self.push(Sample {
+            self.history = [Sample {
                 tick,
                 total_counts: 0,
-            });
+            }; HISTORY];
             return Ok(());
         };
+        let last = self.newest_sample();
         // The change modulo 2^bits, sign-extended: exact for |change| < 2^(bits−1).
-        let change = ((raw.wrapping_sub(last_raw) << self.shift) as i32) >> self.shift;
+        let change =
+            ((raw.wrapping_sub(last_raw).wrapping_shl(self.shift)) as i32).wrapping_shr(self.shift);
         let gap_ticks = tick.wrapping_sub(last.tick);
         let allowed = self.max_counts_per_tick.saturating_mul(gap_ticks);
         if change.unsigned_abs() > allowed {
             return Err(CountFault::Jump);
         }
         self.last_raw = Some(raw);
-        self.push(Sample {
+        self.newest = self.newest.wrapping_add(1) & (HISTORY - 1);
+        self.history[self.newest & (HISTORY - 1)] = Sample {
             tick,
             total_counts: last.total_counts.wrapping_add(i64::from(change)),
-        });
+        };
         Ok(())
     }
 
     /// Ticks since the last accepted reading at `tick` (`None` before the first).
     pub fn ticks_since_accepted(&self, tick: u32) -> Option<u32> {
-        self.newest_sample().map(|s| tick.wrapping_sub(s.tick))
+        self.last_raw
+            .map(|_| tick.wrapping_sub(self.newest_sample().tick))
     }
 
     /// Counts since the first reading (pay-out positive).
     pub fn total_counts(&self) -> i64 {
-        self.newest_sample().map_or(0, |s| s.total_counts)
+        self.newest_sample().total_counts
     }
 
     /// Tether paid out since the first reading, m: total count × m per count (a function of
@@ -122,14 +124,11 @@ impl Odometer {
     }
 
     /// Drum surface speed, m/s (pay-out positive): the count difference over the last
-    /// `speed_window_ticks` accepted readings (fewer at the start) divided by their time. 0
-    /// before the second reading (the drum starts braked, at rest).
+    /// `speed_window_ticks` accepted readings divided by their time. 0 before the second
+    /// reading (the drum starts braked, at rest).
     pub fn speed_mps(&self) -> f32 {
-        let Some(new) = self.newest_sample() else {
-            return 0.0;
-        };
-        let back = self.window.min(self.len.saturating_sub(1));
-        let old = self.history[self.newest.wrapping_sub(back) & (HISTORY - 1)];
+        let new = self.newest_sample();
+        let old = self.history[self.newest.wrapping_sub(self.window) & (HISTORY - 1)];
         let ticks = new.tick.wrapping_sub(old.tick);
         if ticks == 0 {
             return 0.0;
@@ -139,16 +138,8 @@ impl Odometer {
         counts as f32 * self.mps_per_count_per_tick / ticks as f32
     }
 
-    fn newest_sample(&self) -> Option<Sample> {
-        (self.len > 0).then(|| self.history[self.newest & (HISTORY - 1)])
-    }
-
-    fn push(&mut self, s: Sample) {
-        if self.len > 0 {
-            self.newest = (self.newest + 1) & (HISTORY - 1);
-        }
-        self.history[self.newest & (HISTORY - 1)] = s;
-        self.len = (self.len + 1).min(HISTORY);
+    fn newest_sample(&self) -> Sample {
+        self.history[self.newest & (HISTORY - 1)]
     }
 }
 

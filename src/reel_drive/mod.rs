@@ -332,6 +332,9 @@ struct Ramp {
     target_mps: f32,
     /// Signed slope toward the target (0 if already there), m/s².
     slope_mps2: f32,
+    /// Ticks from `start_tick` until the target is reached (integer time: the reference is the
+    /// target from then on, and never passes it before).
+    ramp_ticks: u32,
 }
 
 /// Constants derived once from the configuration.
@@ -394,6 +397,7 @@ impl SpeedLoop {
                 start_tick: 0,
                 target_mps: 0.0,
                 slope_mps2: 0.0,
+                ramp_ticks: 0,
             },
             integral_nm: 0.0,
             tension_n: 0.0,
@@ -529,49 +533,50 @@ impl SpeedLoop {
         }
 
         let tension_n = self.tension(input.tension_n, &mut faults);
-        self.brake = self.next_brake(tick, gap_ticks, speed_mps, count.is_ok());
-
-        // Reference: pinned at rest until the brake is free, then the ramp.
-        if !matches!(self.brake, Brake::Released { .. }) {
-            self.anchor(0.0, tick);
+        let (mut ramp_mps, mut ramp_accel_mps2) = self.reference_at(tick);
+        let was_released = matches!(self.brake, Brake::Released { .. });
+        self.brake = self.next_brake(tick, gap_ticks, ramp_mps, speed_mps, count.is_ok());
+        if !was_released && matches!(self.brake, Brake::Released { .. }) {
+            // Just released: the ramp restarted from rest at this tick.
+            (ramp_mps, ramp_accel_mps2) = self.reference_at(tick);
         }
-        let (ref_mps, ref_accel_mps2) = self.reference_at(tick);
 
         let d = self.derived;
-        let error_mps = ref_mps - speed_mps;
-        let ff_tension_nm = -tension_n * self.cfg.geometry.drum_radius_m;
-        let (p_nm, ff_inertia_nm, ff_friction_nm) = match self.brake {
-            Brake::Released { .. } => {
-                let coulomb = (ref_mps * d.coulomb_per_band)
-                    .max(-self.cfg.drum.coulomb_nm)
-                    .min(self.cfg.drum.coulomb_nm);
-                (
-                    self.cfg.gains.kp_nm_per_mps * error_mps,
-                    d.inertia_per_radius * ref_accel_mps2,
-                    d.viscous_per_radius * ref_mps + coulomb,
-                )
-            }
-            // Releasing: the motor takes over the tension's torque from the brake, nothing
-            // else. Engaged, tripped: the motor is off.
-            _ => {
-                self.integral_nm = 0.0;
-                (0.0, 0.0, 0.0)
-            }
-        };
-        let ff_tension_nm = if self.brake.motor_enabled() {
-            ff_tension_nm
-        } else {
-            0.0
-        };
+        let max_torque_nm = self.cfg.max_torque_nm;
         let limit = self.cfg.duty_limit;
+        let mut ref_mps = 0.0;
+        let mut ref_accel_mps2 = 0.0;
+        let mut p_nm = 0.0;
+        let mut ff_inertia_nm = 0.0;
+        let mut ff_tension_nm = 0.0;
+        let mut ff_friction_nm = 0.0;
+        match self.brake {
+            Brake::Released { .. } => {
+                ref_mps = ramp_mps;
+                ref_accel_mps2 = ramp_accel_mps2;
+                p_nm = self.cfg.gains.kp_nm_per_mps * (ref_mps - speed_mps);
+                ff_inertia_nm = d.inertia_per_radius * ref_accel_mps2;
+                ff_tension_nm = -tension_n * self.cfg.geometry.drum_radius_m;
+                let coulomb_nm = clamp_abs(ref_mps * d.coulomb_per_band, self.cfg.drum.coulomb_nm);
+                ff_friction_nm = d.viscous_per_radius * ref_mps + coulomb_nm;
+            }
+            // The brake lifts: the motor takes over the tension's torque, nothing else.
+            Brake::Releasing { .. } => {
+                ff_tension_nm = -tension_n * self.cfg.geometry.drum_radius_m;
+                self.integral_nm = 0.0;
+            }
+            // The motor is off.
+            Brake::Engaged | Brake::Tripped(_) => self.integral_nm = 0.0,
+        }
+        let error_mps = ref_mps - speed_mps;
         let without_i_nm = p_nm + ff_inertia_nm + ff_tension_nm + ff_friction_nm;
         if matches!(self.brake, Brake::Released { .. }) {
             // Conditional integration: no growth that pushes a saturated output further out.
             let dt_s = gap_ticks as f32 * d.tick_s;
-            let max = self.cfg.max_torque_nm;
-            let candidate = (self.integral_nm + self.cfg.gains.ki_nm_per_m * error_mps * dt_s)
-                .max(-max)
-                .min(max);
+            let candidate = clamp_abs(
+                self.integral_nm + self.cfg.gains.ki_nm_per_m * error_mps * dt_s,
+                max_torque_nm,
+            );
             let duty = (without_i_nm + candidate) * d.per_max_torque;
             let winding_up = duty.abs() > limit && duty * error_mps > 0.0;
             if !winding_up {
@@ -581,14 +586,14 @@ impl SpeedLoop {
         let torque_nm = without_i_nm + self.integral_nm;
         let raw_duty = torque_nm * d.per_max_torque;
         let saturated = raw_duty.abs() > limit;
-        let mut duty = raw_duty.max(-limit).min(limit);
+        let mut duty = clamp_abs(raw_duty, limit);
 
         // Saturation held too long (reported), stall (trips).
-        if saturated {
-            self.saturated_ticks = self.saturated_ticks.saturating_add(gap_ticks);
+        self.saturated_ticks = if saturated {
+            self.saturated_ticks.saturating_add(gap_ticks)
         } else {
-            self.saturated_ticks = 0;
-        }
+            0
+        };
         if self.saturated_ticks >= self.cfg.faults.saturation_ticks {
             faults.insert(DriveFault::DutySaturated);
         }
@@ -652,7 +657,15 @@ impl SpeedLoop {
     }
 
     /// The brake's next state (see [`Brake`]).
-    fn next_brake(&self, tick: u32, gap_ticks: u32, speed_mps: f32, counted: bool) -> Brake {
+    /// Entering `Released` restarts the ramp from rest at `tick` (the drum was held until now).
+    fn next_brake(
+        &mut self,
+        tick: u32,
+        gap_ticks: u32,
+        ref_mps: f32,
+        speed_mps: f32,
+        counted: bool,
+    ) -> Brake {
         let rest = self.cfg.brake.rest_speed_mps;
         let hold = self.command.safe_hold;
         let target_moving = self.command.rate_mps.abs() > rest;
@@ -671,6 +684,7 @@ impl SpeedLoop {
                 if !target_moving || hold {
                     Brake::Engaged
                 } else if ticks_left <= gap_ticks {
+                    self.anchor(0.0, tick);
                     Brake::Released { rest_ticks: 0 }
                 } else {
                     Brake::Releasing {
@@ -679,7 +693,6 @@ impl SpeedLoop {
                 }
             }
             Brake::Released { rest_ticks } => {
-                let (ref_mps, _) = self.reference_at(tick);
                 let at_rest = !target_moving && ref_mps.abs() <= rest && speed_mps.abs() <= rest;
                 if !at_rest {
                     Brake::Released { rest_ticks: 0 }
@@ -707,40 +720,65 @@ impl SpeedLoop {
             0.0
         };
         let per_period = dv.abs() * self.derived.outer_period_per_s;
-        let magnitude = law.max(per_period).min(self.cfg.max_accel_mps2);
+        let fastest = if law > per_period { law } else { per_period };
+        let magnitude = clamp_abs(fastest, self.cfg.max_accel_mps2);
+        // Whole ticks to the target, rounded up (`as` saturates; 0 when already there).
+        let ticks = dv.abs() / magnitude * self.cfg.inner_rate_hz as f32;
+        let whole = ticks as u32;
         self.ramp = Ramp {
             start_mps,
             start_tick: tick,
             target_mps: target,
-            slope_mps2: if dv == 0.0 {
-                0.0
+            slope_mps2: magnitude.copysign(dv),
+            ramp_ticks: if (whole as f32) < ticks {
+                whole.saturating_add(1)
             } else {
-                magnitude.copysign(dv)
+                whole
             },
         };
     }
 
-    /// The reference speed and acceleration at `tick`: the ramp, stopped at its target.
+    /// The reference speed and acceleration at `tick`: the ramp, stopped at its target. (Only
+    /// used while the brake is free; the ramp restarts from rest when it is released.)
     fn reference_at(&self, tick: u32) -> (f32, f32) {
         let r = &self.ramp;
-        let age_s = tick.wrapping_sub(r.start_tick) as f32 * self.derived.tick_s;
-        let v = r.start_mps + r.slope_mps2 * age_s;
-        let passed = if r.slope_mps2 > 0.0 {
-            v >= r.target_mps
-        } else {
-            v <= r.target_mps
-        };
-        if passed {
+        let age_ticks = tick.wrapping_sub(r.start_tick);
+        if age_ticks >= r.ramp_ticks {
             (r.target_mps, 0.0)
         } else {
-            (v, r.slope_mps2)
+            let age_s = age_ticks as f32 * self.derived.tick_s;
+            (r.start_mps + r.slope_mps2 * age_s, r.slope_mps2)
         }
+    }
+}
+
+/// `x` limited to [−limit, limit] (limit ≥ 0), by comparisons: `f32::clamp` panics on bad
+/// bounds and `f32::min`/`max` are library calls (`fminf`/`fmaxf`) on the Cortex-M4F. A NaN `x`
+/// gives 0 (no torque).
+fn clamp_abs(x: f32, limit: f32) -> f32 {
+    if x > limit {
+        limit
+    } else if x < -limit {
+        -limit
+    } else if x.is_nan() {
+        0.0
+    } else {
+        x
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn clamp_abs_saturates_and_zeroes_nan() {
+        assert_eq!(clamp_abs(2.0, 1.0), 1.0);
+        assert_eq!(clamp_abs(-2.0, 1.0), -1.0);
+        assert_eq!(clamp_abs(0.5, 1.0), 0.5);
+        assert_eq!(clamp_abs(f32::NAN, 1.0), 0.0);
+        assert_eq!(clamp_abs(f32::NEG_INFINITY, 1.0), -1.0);
+    }
 
     #[test]
     fn the_ramp_meets_the_command_within_a_period_and_never_passes_it() {
