@@ -440,6 +440,25 @@ fn missing_counts_are_bridged_for_10_ticks_then_trip() {
     run.tick += 11;
     let out = run.tick();
     assert_eq!(out.brake, Brake::Tripped(DriveFault::EncoderMissing));
+    // Cleared after a long outage (the drum turned 1.5 counter ranges meanwhile): the next
+    // reading is the new reference, not a (wrapped, ambiguous) change; the drive releases and
+    // drives again without a fault.
+    for _ in 0..5000 {
+        run.tick();
+    }
+    run.drum.angle_rad += 1.5 * 65_536.0 / run.drum.counts_per_rev * TAU;
+    assert_eq!(run.drive.clear_trip(), Some(DriveFault::EncoderMissing));
+    let before = run.drive.odometer().total_counts();
+    let start_counts = run.drum.counts(); // braked: it stays there until the release
+    for _ in 0..3000 {
+        let out = run.tick();
+        assert!(out.faults.is_empty(), "{out:?}");
+    }
+    assert!(matches!(run.drive.brake(), Brake::Released { .. }));
+    assert!((run.drum.speed_mps() - 2.0).abs() < 2e-3);
+    let counted = run.drive.odometer().total_counts() - before;
+    let driven = run.read_counts - start_counts;
+    assert!(counted > 0 && counted == driven, "{counted} {driven}");
 }
 
 #[test]

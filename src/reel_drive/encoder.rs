@@ -52,10 +52,11 @@ pub struct Odometer {
     /// m/s per count per tick: m per count / tick.
     mps_per_count_per_tick: f32,
     window: usize,
-    /// The last accepted raw counter value; `None` before the first reading.
+    /// The last accepted raw counter value; `None` before the first reading and after a
+    /// [`resync`](Self::resync): the next reading is then the reference, not a change.
     last_raw: Option<u32>,
-    /// The accepted readings, newest at `newest`; the first reading fills every slot, so the
-    /// window always has a start (no count of valid entries to keep).
+    /// The accepted readings, newest at `newest`; the reference reading fills every slot, so
+    /// the window always has a start (no count of valid entries to keep).
     history: [Sample; HISTORY],
     newest: usize,
 }
@@ -81,10 +82,11 @@ impl Odometer {
     pub fn update(&mut self, tick: u32, raw: Option<u32>) -> Result<(), CountFault> {
         let raw = raw.ok_or(CountFault::Missing)?;
         let Some(last_raw) = self.last_raw else {
+            // The reference reading: the total stays (0 at the first), the speed restarts at 0.
             self.last_raw = Some(raw);
             self.history = [Sample {
                 tick,
-                total_counts: 0,
+                total_counts: self.total_counts(),
             }; HISTORY];
             return Ok(());
         };
@@ -104,6 +106,15 @@ impl Odometer {
             total_counts: last.total_counts.wrapping_add(i64::from(change)),
         };
         Ok(())
+    }
+
+    /// Forgets the counter's reference: the next reading is taken as the new one, and the
+    /// total count continues from where it is. For a counter that was lost (an encoder trip):
+    /// after a long gap a change of the counter is ambiguous modulo 2^bits, so the travel
+    /// during the outage is not counted, and the paid-out length must be re-referenced by the
+    /// outer loop's length sensor.
+    pub fn resync(&mut self) {
+        self.last_raw = None;
     }
 
     /// Ticks since the last accepted reading at `tick` (`None` before the first).

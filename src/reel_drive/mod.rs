@@ -469,14 +469,17 @@ impl SpeedLoop {
         }
     }
 
-    /// Clears a trip: the brake stays engaged and releases again only for a moving command.
-    /// Returns the fault that was cleared.
+    /// Clears a trip: the brake stays engaged and releases again only for a moving command
+    /// and a fresh encoder reading, which becomes the counter's new reference
+    /// ([`Odometer::resync`]: whatever the drum did while tripped is not counted). Returns the
+    /// fault that was cleared.
     pub fn clear_trip(&mut self) -> Option<DriveFault> {
         match self.brake {
             Brake::Tripped(f) => {
                 self.brake = Brake::Engaged;
                 self.stall_ticks = 0;
                 self.saturated_ticks = 0;
+                self.odometer.resync();
                 Some(f)
             }
             _ => None,
