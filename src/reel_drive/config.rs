@@ -139,7 +139,11 @@ impl DriveConfig {
     /// counts per drum revolution, 15.3 µm per count) in a 16-bit timer counter; J = 0.05
     /// kg m², b = 0.01 N m s/rad, c = 0.2 N m; 5 N m at full duty; 15 m/s and 5 m/s² (the
     /// paper envelope's rate); PI crossing over at ω_c = kp r / J = 30 rad/s with its zero at
-    /// ω_c / 4; brake 50 ms to release, engaged after 200 ms at rest (5 mm/s).
+    /// ω_c / 4; brake 50 ms to release, engaged after 200 ms at rest (5 mm/s); an encoder
+    /// jump is a count faster than 20 m/s (1304 counts a tick), and 10 ticks without an
+    /// accepted count trip the drive (11 × 1304 < 2¹⁵, so the 16-bit counter stays
+    /// unambiguous); stall: duty ≥ 0.9 below 2 cm/s for 0.5 s; saturation reported after 2 s;
+    /// tension plausible in [−5, 200] N.
     pub fn example() -> Self {
         Self {
             inner_rate_hz: 1000,

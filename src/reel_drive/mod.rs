@@ -756,8 +756,9 @@ impl SpeedLoop {
 }
 
 /// `x` limited to [−limit, limit] (limit ≥ 0), by comparisons: `f32::clamp` panics on bad
-/// bounds and `f32::min`/`max` are library calls (`fminf`/`fmaxf`) on the Cortex-M4F. A NaN `x`
-/// gives 0 (no torque).
+/// bounds, and `f32::min`/`max` are library calls (`fminf`/`fmaxf`) on the Cortex-M4F — with
+/// them the step took 420 instructions (median, `examples/bench_speed_loop.rs`), 328 with
+/// this and the reference evaluated once. A NaN `x` gives 0 (no torque).
 fn clamp_abs(x: f32, limit: f32) -> f32 {
     if x > limit {
         limit
