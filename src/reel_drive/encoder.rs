@@ -66,7 +66,7 @@ impl Odometer {
     pub fn new(cfg: &DriveConfig) -> Self {
         let m_per_count = cfg.geometry.m_per_count();
         Self {
-            shift: 32 - cfg.geometry.encoder_bits,
+            shift: 32_u32.saturating_sub(cfg.geometry.encoder_bits),
             max_counts_per_tick: cfg.max_counts_per_tick(),
             m_per_count,
             mps_per_count_per_tick: m_per_count * cfg.inner_rate_hz as f32,
