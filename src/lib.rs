@@ -125,6 +125,7 @@ pub mod orbit;
 pub mod real;
 #[cfg(feature = "recordings")]
 pub mod recordings;
+pub mod reel_drive;
 pub mod schedule;
 pub mod stability;
 
