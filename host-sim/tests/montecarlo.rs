@@ -415,3 +415,32 @@ fn bad_dispersions_shards_and_runs_are_clear_errors() {
     );
     rejected(&[sc, "--runs", "0"], &["--runs"]);
 }
+
+/// Issue 16 §5: absurd counts are refused before any work (exit 2, naming the flag and value),
+/// not a capacity-overflow panic (18 446 744 073 709 551 615 runs) or an aborted allocation
+/// (4 000 000 000 runs); `--threads` has an upper bound too.
+#[test]
+fn absurd_runs_and_threads_are_refused_before_any_work() {
+    let sc = scenario();
+    let sc = sc.to_str().unwrap();
+    for runs in ["18446744073709551615", "4000000000", "1000001"] {
+        rejected(&[sc, "--runs", runs], &["--runs", runs, "1..=1000000"]);
+    }
+    for threads in ["1025", "18446744073709551615"] {
+        rejected(
+            &[sc, "--runs", "2", "--threads", threads],
+            &["--threads", threads],
+        );
+    }
+}
+
+/// Issue 15 §5: a scenario without `[montecarlo]` dispersions used to fly N identical runs and
+/// report 100 % pass; it is an error that says what is missing.
+#[test]
+fn a_scenario_without_dispersions_is_an_error() {
+    let sc = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper.toml");
+    rejected(
+        &[sc.to_str().unwrap(), "--runs", "3"],
+        &["paper.toml", "no [[montecarlo.dispersion]]"],
+    );
+}

@@ -22,13 +22,20 @@ use super::{plots, table};
 use crate::run_cmd::{check_output_dir, write_file, UsageError};
 use crate::scenario::Scenario;
 
+/// Largest `--runs`: a million runs (each run's record stays in memory until the campaign's
+/// files are written; about 0.05 s of computing each).
+pub const MAX_RUNS: u64 = 1_000_000;
+
+/// Largest `--threads`: far above any machine's cores, below any operating system's limit.
+pub const MAX_THREADS: usize = 1024;
+
 /// Arguments of `tss-sim montecarlo`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct MonteCarloArgs {
     /// Scenario file (TOML) with a `[montecarlo]` section, e.g. scenarios/paper-montecarlo.toml.
     pub scenario: PathBuf,
-    /// Number of runs of the whole campaign.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    /// Number of runs of the whole campaign (1 to 1 000 000).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=MAX_RUNS))]
     pub runs: u64,
     /// Seed of the campaign: run i depends on (seed, i) only.
     #[arg(long, value_name = "S", default_value_t = 0)]
@@ -40,8 +47,8 @@ pub struct MonteCarloArgs {
     /// with `tss-sim merge`).
     #[arg(long, value_name = "K/N", value_parser = Shard::parse)]
     pub shard: Option<Shard>,
-    /// Worker threads (0: one per core). The results do not depend on it.
-    #[arg(long, value_name = "T", default_value_t = 0)]
+    /// Worker threads (0: one per core; at most 1024). The results do not depend on it.
+    #[arg(long, value_name = "T", default_value_t = 0, value_parser = threads_in_range)]
     pub threads: usize,
     /// Do not draw the figures (e.g. for shards: `merge` draws them).
     #[arg(long)]
@@ -50,6 +57,17 @@ pub struct MonteCarloArgs {
     /// `--set simulation.duration_s=3600` (repeatable; applied in order).
     #[arg(long = "set", short = 's', value_name = "KEY=VALUE")]
     pub set: Vec<String>,
+}
+
+/// Parses `--threads`: 0 to [`MAX_THREADS`].
+fn threads_in_range(text: &str) -> Result<usize, String> {
+    let n: usize = text
+        .parse()
+        .map_err(|_| format!("`{text}` is not a whole number"))?;
+    if n > MAX_THREADS {
+        return Err(format!("{n} is not in 0..={MAX_THREADS}"));
+    }
+    Ok(n)
 }
 
 /// Arguments of `tss-sim merge`.
@@ -128,6 +146,15 @@ fn progress_bar(runs: u64) -> ProgressBar {
 /// `tss-sim montecarlo`.
 pub fn montecarlo(args: &MonteCarloArgs) -> anyhow::Result<()> {
     let scenario = Scenario::load(&args.scenario, &args.set)?;
+    if scenario.montecarlo.dispersion.is_empty() {
+        return Err(UsageError(format!(
+            "{}: no [[montecarlo.dispersion]] in the scenario: nothing would vary between runs \
+             (each would fly the nominal scenario); add the dispersed fields, as \
+             scenarios/paper-montecarlo.toml does",
+            args.scenario.display()
+        ))
+        .into());
+    }
     check_output_dir(&args.out)?;
     let shard = args.shard.unwrap_or(Shard::WHOLE);
     if shard.count > args.runs {
