@@ -292,6 +292,19 @@ pub const PROBE_TIMES_S: [f64; PAPER_TABLE1_LEN] = {
     times
 };
 
+/// The Table-1 instants a run of `scenario` reaches (t ≤ duration, whole control periods).
+pub fn probe_times_for(scenario: &crate::scenario::Scenario) -> Vec<f64> {
+    let period = scenario.controller.period_s;
+    PROBE_TIMES_S
+        .iter()
+        .copied()
+        .filter(|&t| {
+            let n = (t / period).round();
+            t <= scenario.simulation.duration_s && (n * period - t).abs() <= 1e-9 * t.max(period)
+        })
+        .collect()
+}
+
 /// A probe is matched to a Table-1 instant when their times differ by at most this, s.
 pub const PROBE_TIME_TOLERANCE_S: f64 = 1e-6;
 
