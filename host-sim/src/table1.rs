@@ -418,8 +418,8 @@ impl Table1Comparison {
         );
         let _ = writeln!(
             out,
-            "  {:<39}  |  stage 2 (keep at 2 km)",
-            "stage 1 (keep at 30 km)"
+            "  {:<39}  |  stage 2 (paper: keep at 2 km)",
+            "stage 1 (paper: keep at 30 km)"
         );
         let _ = writeln!(out, "  {head}  |  {head}");
         for i in 0..s1.len().max(s2.len()) {
@@ -450,7 +450,10 @@ impl Table1Comparison {
                     );
                 }
                 None => {
-                    let _ = writeln!(out, "  stage {n}: not reached by this run");
+                    let _ = writeln!(
+                        out,
+                        "  stage {n}: no comparison, the run ended before these instants"
+                    );
                 }
             }
         }
@@ -526,7 +529,10 @@ mod tests {
         assert_eq!(m1.compared, 21);
         assert_eq!(c.max_abs_difference(2), None);
         let text = c.render();
-        assert!(text.contains("stage 2: not reached by this run"), "{text}");
+        assert!(
+            text.contains("stage 2: no comparison, the run ended before these instants"),
+            "{text}"
+        );
         let mut csv = Vec::new();
         c.write_csv(&mut csv).unwrap();
         let csv = String::from_utf8(csv).unwrap();
