@@ -13,7 +13,7 @@
 
 use std::fmt::Write as _;
 
-use crate::history::{History, PhaseLabel, Sample};
+use crate::history::{flag_names, History, PhaseLabel, Sample, FLAG_NAMES};
 use crate::scenario::Scenario;
 
 /// How close to a keep length counts as having reached it, m (the paper's Table 1 has the
@@ -84,6 +84,8 @@ pub struct Summary {
     pub tension: Vec<TensionRange>,
     /// Samples whose controller flags are not zero, and the OR of all flags.
     pub flagged: (usize, u32),
+    /// For each flag raised in the run: its name and the samples that carry it.
+    pub flag_counts: Vec<(&'static str, usize)>,
     /// The last sample.
     pub last: Option<Sample>,
 }
@@ -218,6 +220,12 @@ pub fn summarize(scenario: &Scenario, history: &History) -> Summary {
         (n + usize::from(s.flags != 0), or | s.flags)
     });
 
+    let flag_counts = FLAG_NAMES
+        .iter()
+        .map(|&(bit, name)| (name, samples.iter().filter(|s| s.flags & bit != 0).count()))
+        .filter(|&(_, n)| n > 0)
+        .collect();
+
     Summary {
         name: scenario.name.clone(),
         samples: samples.len(),
@@ -227,6 +235,7 @@ pub fn summarize(scenario: &Scenario, history: &History) -> Summary {
         stage1_max,
         tension,
         flagged,
+        flag_counts,
         last: samples.last().copied(),
     }
 }
@@ -315,9 +324,16 @@ impl Summary {
         if n == 0 {
             let _ = writeln!(o, "  controller flags: none raised");
         } else {
+            let counts: Vec<String> = self
+                .flag_counts
+                .iter()
+                .map(|(name, k)| format!("{name} {k}"))
+                .collect();
             let _ = writeln!(
                 o,
-                "  controller flags: raised in {n} samples (OR of all = {or:#010x})"
+                "  controller flags: raised in {n} samples: {} (flags column: {or:#x} = {})",
+                counts.join(", "),
+                flag_names(or)
             );
         }
         if let Some(s) = self.last {
