@@ -79,6 +79,11 @@ pub const MAX_FRAME_LEN: usize = 80;
 /// Largest frame on the wire: COBS adds one byte per 254 (and one), plus the `0x00` delimiter.
 pub const MAX_WIRE_LEN: usize = MAX_FRAME_LEN + MAX_FRAME_LEN / 254 + 2;
 
+/// Most control periods of one PIL run (ticks 0 ..= `MAX_TICKS` − 1): the firmware ends a
+/// longer run as a failure, and the plant refuses such a scenario before it starts. The
+/// paper's 20-h mission is 72 001 ticks.
+pub const MAX_TICKS: u32 = 200_000;
+
 /// The wire delimiter between frames.
 pub const DELIMITER: u8 = 0x00;
 

@@ -12,10 +12,13 @@
 //! **Link faults.** The scenario's `[link]` section injects faults into the sample frames, each
 //! frame meeting at most one: dropped (not sent; the firmware times out), corrupted (one byte
 //! changed, never to the delimiter; the firmware rejects it), duplicated (sent twice; the
-//! firmware discards the copy) or reordered (held back and sent late, after the next period's
-//! frame; the firmware times out, then discards it). Both sides count: the injector here
-//! ([`Injected`]), the firmware in its `Report` and log. [`PilReport::expected_firmware_counts`]
-//! says what the firmware must have seen.
+//! firmware discards the copy) or reordered (held back and sent late, just before the next
+//! period's frame, or before `End`; the firmware times out, then discards it). Both sides
+//! count: the injector here ([`Injected`]), the firmware in its `Report` and log.
+//! [`PilReport::expected_firmware_counts`] says what the firmware must have seen, exactly,
+//! whichever frames are lost: the firmware awaits tick 0 from the start (a lost first frame is
+//! a timeout like any other), and the `End` frame's sequence number reveals frames lost at the
+//! end. A run has at most [`link::MAX_TICKS`] periods ([`check_duration`]).
 //!
 //! **Time.** Lock-step: the firmware blocks on each sample, the plant on each command, and the
 //! tick number in the frames is the authority. The firmware's sample timeout is counted in its
@@ -96,6 +99,19 @@ pub enum PilError {
         firmware: u32,
         /// Digest of the scenario's configuration.
         scenario: u32,
+    },
+    /// The scenario has more control periods than one PIL run may ([`link::MAX_TICKS`]).
+    #[error(
+        "simulation.duration_s = {duration_s} s is {ticks} control periods: a PIL run has at \
+         most {max} (the firmware's bound, link::MAX_TICKS)"
+    )]
+    TooLong {
+        /// The scenario's duration, s.
+        duration_s: f64,
+        /// Its control periods (ticks 0 ..= duration / period).
+        ticks: f64,
+        /// The bound.
+        max: u32,
     },
     /// The firmware broke the protocol, stopped answering or failed.
     #[error("{0} (the firmware's log: {1})")]
@@ -739,6 +755,20 @@ fn wait_exit(child: &mut Child, timeout: Duration) -> Option<ExitStatus> {
     }
 }
 
+/// Checks that `sc` fits in one PIL run ([`link::MAX_TICKS`] control periods).
+pub fn check_duration(sc: &Scenario) -> Result<(), PilError> {
+    let ticks = (sc.simulation.duration_s / sc.controller.period_s).round() + 1.0;
+    if ticks <= f64::from(link::MAX_TICKS) {
+        Ok(())
+    } else {
+        Err(PilError::TooLong {
+            duration_s: sc.simulation.duration_s,
+            ticks,
+            max: link::MAX_TICKS,
+        })
+    }
+}
+
 /// Runs `sc` with the firmware `firmware` in the loop (QEMU), its log written to `log`:
 /// the same history as [`sim::run`], and the link's report.
 pub fn run(
@@ -749,6 +779,7 @@ pub fn run(
     progress: &mut dyn FnMut(f64),
 ) -> Result<(History, PilReport), SimError> {
     let wrap = |e: PilError| SimError::Link(Box::new(e));
+    check_duration(sc).map_err(wrap)?;
     let mut link = PilLink::start(sc, firmware, log).map_err(wrap)?;
     let history = sim::run_stepper::<f32, _>(sc, &mut link, probe_times_s, progress)?;
     let ticks = history.faults.ticks;

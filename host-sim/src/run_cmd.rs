@@ -127,6 +127,9 @@ fn run_pil(args: &RunArgs) -> anyhow::Result<()> {
     if !firmware.is_file() {
         return Err(UsageError(PilError::MissingFirmware(firmware).to_string()).into());
     }
+    // Checked here too, so that a scenario too long for the firmware is a usage error.
+    let scenario = Scenario::load(&args.scenario, &args.set)?;
+    pil::check_duration(&scenario).map_err(|e| UsageError(e.to_string()))?;
     let mut report = None;
     let mut outcome = run_with(args, |sc, probes, out, progress| {
         let log = out.stage(FIRMWARE_LOG);

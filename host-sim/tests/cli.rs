@@ -82,3 +82,30 @@ fn every_command_that_writes_files_takes_dash_o() {
         assert!(text(&o.stdout).contains("-o, --out"), "{cmd} --help");
     }
 }
+
+/// A PIL scenario longer than the firmware's bound (`link::MAX_TICKS` periods) used to run for
+/// 200 000 periods and then fail; it is refused before QEMU starts (exit 2). Any existing file
+/// passes the `--firmware` check, so this needs no ELF.
+#[test]
+fn a_pil_run_longer_than_the_firmware_allows_is_refused_before_it_starts() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("pil");
+    let o = tss_sim(&[
+        "run",
+        paper().to_str().unwrap(),
+        "--pil",
+        "--firmware",
+        BIN,
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        "simulation.duration_s=200000",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("simulation.duration_s = 200000") && err.contains("200001"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}

@@ -47,9 +47,10 @@ use super::uart::{Uart, UartError};
 /// the wait lasts at least one full control period wherever in a period it starts.
 pub const TIMEOUT_TICKS: u32 = 2;
 
-/// Hard bound on the control periods of one PIL run: the paper's 20 h mission (72 001 ticks)
-/// with room to spare. A run still going then is a failure, never a hang.
-pub const MAX_TICKS: u32 = 200_000;
+/// Hard bound on the control periods of one PIL run ([`link::MAX_TICKS`]: the paper's 20 h
+/// mission, 72 001 ticks, with room to spare). A run still going then is a failure, never a
+/// hang.
+pub const MAX_TICKS: u32 = link::MAX_TICKS;
 
 /// Timeouts in a row after which the plant is taken to be gone: the run ends with a failure.
 pub const MAX_SILENT_PERIODS: u32 = 600;
