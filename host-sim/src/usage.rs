@@ -3,6 +3,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::scenario::ScenarioError;
+use crate::sim::SimError;
 
 /// A command-line mistake found before any work (exit code 2): a bad argument, scenario file,
 /// `--set` override or output path.
@@ -10,11 +11,17 @@ use crate::scenario::ScenarioError;
 #[error("{0}")]
 pub struct UsageError(pub String);
 
-/// Is `err` (or its cause) the user's mistake — a bad scenario, override or output path — so
-/// that the process should exit with code 2 rather than 1?
+/// Is `err` (or its cause) the user's mistake — a bad scenario, override or output path, or
+/// scenario values the simulation refuses before its first step (a controller configuration
+/// the core rejects, a time that is not a whole number of periods) — so that the process should
+/// exit with code 2 rather than 1?
 pub fn is_usage_error(err: &anyhow::Error) -> bool {
-    err.chain()
-        .any(|e| e.is::<ScenarioError>() || e.is::<UsageError>())
+    err.chain().any(|e| {
+        e.is::<ScenarioError>()
+            || e.is::<UsageError>()
+            || e.downcast_ref::<SimError>()
+                .is_some_and(|s| matches!(s, SimError::Config(_) | SimError::Timing { .. }))
+    })
 }
 
 static QUIET: AtomicBool = AtomicBool::new(false);

@@ -109,3 +109,23 @@ fn a_pil_run_longer_than_the_firmware_allows_is_refused_before_it_starts() {
     );
     assert!(!out.exists());
 }
+
+/// Scenario values that the simulation refuses before its first step (here an output interval
+/// that is no whole number of periods in f64) are the user's mistake: exit 2, not 1, and
+/// nothing left behind.
+#[test]
+fn values_the_simulation_refuses_before_its_first_step_are_usage_errors() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("timing");
+    let o = tss_sim(&[
+        "run",
+        paper().to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        "simulation.output_interval_s=1e300",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
+    assert!(text(&o.stderr).contains("simulation.output_interval_s"));
+    assert!(!out.exists());
+}
