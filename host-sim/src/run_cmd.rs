@@ -33,7 +33,7 @@ pub struct RunArgs {
     /// Scenario file (TOML), e.g. scenarios/paper.toml.
     pub scenario: PathBuf,
     /// Output directory (created if needed; the files of an earlier run in it are replaced)
-    /// [default: out/<scenario name>].
+    /// [default: out/NAME, NAME being the scenario's name].
     #[arg(long, short, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Override one scenario field, dotted key and TOML value, e.g.
