@@ -444,3 +444,21 @@ fn a_scenario_without_dispersions_is_an_error() {
         &["paper.toml", "no [[montecarlo.dispersion]]"],
     );
 }
+
+/// Issue 16 §5: a campaign replaces the files of an earlier one in its directory, figures
+/// included: with --no-figures, the earlier campaign's figures are removed rather than left
+/// next to results they do not show; other files stay.
+#[test]
+fn a_campaign_replaces_an_earlier_campaigns_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("mc");
+    std::fs::create_dir_all(&out).unwrap();
+    for f in ["mc_histograms.png", "mc_scatter_keep1_max_error_m.svg", "notes.md"] {
+        std::fs::write(out.join(f), "earlier").unwrap();
+    }
+    campaign(&out, 2, 7, &SHORT);
+    assert!(!out.join("mc_histograms.png").exists());
+    assert!(!out.join("mc_scatter_keep1_max_error_m.svg").exists());
+    assert!(out.join("notes.md").exists());
+    assert!(out.join("runs.csv").is_file());
+}
