@@ -50,6 +50,33 @@ struct Frozen {
     massless: Option<MassCoefficients<f64>>,
 }
 
+/// The terms Eqs. 5b and 5c share at one state (see [`Plant::terms`]).
+#[derive(Clone, Copy, Debug)]
+struct Terms {
+    /// θ̇, rad/s.
+    theta_rate: f64,
+    /// θ̈, rad/s².
+    theta_accel: f64,
+    /// μ/R³, 1/s².
+    gg: f64,
+    /// θ̇ + α̇, rad/s.
+    spin: f64,
+    /// (2 + μ3) l̇/l, 1/s.
+    stretch: f64,
+}
+
+impl Terms {
+    /// Eq. 5b: α̈ = −(θ̇ + α̇)[(2 + μ3) l̇/l − 2β̇ tan β] − (3/2)(μ/R³) sin 2α − θ̈, with
+    /// `beta_coupling` = 2β̇ tan β (0 in the orbit plane: `stretch − 0` is `stretch` exactly,
+    /// so the in-plane shortcut is the same equation bit for bit).
+    #[inline]
+    fn alpha_accel(&self, alpha: f64, beta_coupling: f64) -> f64 {
+        -self.spin * (self.stretch - beta_coupling)
+            - 1.5 * self.gg * (2.0 * alpha).sin()
+            - self.theta_accel
+    }
+}
+
 impl Plant {
     /// The state-independent quantities of this plant (see [`Frozen`]).
     fn frozen(&self) -> Frozen {
@@ -89,6 +116,22 @@ impl Plant {
         }
     }
 
+    /// The terms of Eqs. 5b and 5c at true anomaly θ and length l with the reel at l̇ =
+    /// `rate_mps` and α̇ = `alpha_rate`: the orbit's θ̇, θ̈ and μ/R³, the spin θ̇ + α̇ and the
+    /// stretch (2 + μ3) l̇/l.
+    #[inline]
+    fn terms(&self, f: &Frozen, theta: f64, l: f64, alpha_rate: f64, rate_mps: f64) -> Terms {
+        let (theta_rate, theta_accel, gg) = self.orbit_terms(f, theta);
+        let mu3 = self.mass_terms(f, l).mu3;
+        Terms {
+            theta_rate,
+            theta_accel,
+            gg,
+            spin: theta_rate + alpha_rate,
+            stretch: (2.0 + mu3) * rate_mps / l,
+        }
+    }
+
     /// Time derivative of the state with the reel running at `rate_mps` (Eqs. 5b, 5c).
     pub fn derivative(&self, x: &State, rate_mps: f64) -> State {
         self.derivative_with(&self.frozen(), x, rate_mps)
@@ -97,30 +140,23 @@ impl Plant {
     /// [`Plant::derivative`] with the state-independent quantities already evaluated.
     #[inline]
     fn derivative_with(&self, f: &Frozen, x: &State, rate_mps: f64) -> State {
-        let theta = x[ix::THETA];
-        let l = x[ix::LENGTH];
         let (alpha, alpha_rate) = (x[ix::ALPHA], x[ix::ALPHA_RATE]);
         let (beta, beta_rate) = (x[ix::BETA], x[ix::BETA_RATE]);
-        let (theta_rate, theta_accel, gg) = self.orbit_terms(f, theta);
-        let mu3 = self.mass_terms(f, l).mu3;
-        let spin = theta_rate + alpha_rate;
-        let stretch = (2.0 + mu3) * rate_mps / l;
+        let t = self.terms(f, x[ix::THETA], x[ix::LENGTH], alpha_rate, rate_mps);
         if beta == 0.0 && beta_rate == 0.0 {
             // In the orbit plane (β = β̇ = 0, which Eq. 5c keeps): tan β = sin 2β = 0, so the
             // β terms vanish and β̈ = 0.
-            let alpha_accel = -spin * stretch - 1.5 * gg * (2.0 * alpha).sin() - theta_accel;
-            return State::from([theta_rate, rate_mps, alpha_rate, alpha_accel, 0.0, 0.0]);
+            let alpha_accel = t.alpha_accel(alpha, 0.0);
+            return State::from([t.theta_rate, rate_mps, alpha_rate, alpha_accel, 0.0, 0.0]);
         }
-        // Eq. 5b
-        let alpha_accel = -spin * (stretch - 2.0 * beta_rate * beta.tan())
-            - 1.5 * gg * (2.0 * alpha).sin()
-            - theta_accel;
+        let alpha_accel = t.alpha_accel(alpha, 2.0 * beta_rate * beta.tan());
         // Eq. 5c
+        let (spin, stretch, gg) = (t.spin, t.stretch, t.gg);
         let beta_accel = -stretch * beta_rate
             - 0.5 * spin * spin * (2.0 * beta).sin()
             - 1.5 * gg * alpha.cos().powi(2) * (2.0 * beta).sin();
         State::from([
-            theta_rate,
+            t.theta_rate,
             rate_mps,
             alpha_rate,
             alpha_accel,
@@ -157,12 +193,8 @@ impl Plant {
     fn rk4_in_plane(&self, f: &Frozen, x: &State, [v0, v1, v2]: [f64; 3], h_s: f64) -> State {
         // (θ̇, l̇, α̇, α̈) at (θ, l, α, α̇) with the reel at `v`: Eq. 5b in the plane.
         let d = |y: [f64; 4], v: f64| -> [f64; 4] {
-            let (theta_rate, theta_accel, gg) = self.orbit_terms(f, y[0]);
-            let mu3 = self.mass_terms(f, y[1]).mu3;
-            let spin = theta_rate + y[3];
-            let stretch = (2.0 + mu3) * v / y[1];
-            let alpha_accel = -spin * stretch - 1.5 * gg * (2.0 * y[2]).sin() - theta_accel;
-            [theta_rate, v, y[3], alpha_accel]
+            let t = self.terms(f, y[0], y[1], y[3], v);
+            [t.theta_rate, v, y[3], t.alpha_accel(y[2], 0.0)]
         };
         let stage = |k: [f64; 4], c: f64| -> [f64; 4] {
             [

@@ -7,13 +7,13 @@
 //! drives the reel (`reel::Reel`: ideal by default, else lagging and saturating) while RK4
 //! integrates the plant. Every tick feeds the fault summary (`History::faults`).
 
-use crate::faults::{Injector, Sensed, SummaryBuilder, TickRecord, Truth};
+use crate::faults::{InjectionPlan, Injector, Sensed, SummaryBuilder, TickRecord, Truth};
 use crate::history::{History, PhaseLabel, Sample};
 use crate::plant::{ix, Plant, State};
-use crate::reel::{Reel, ReelSaturation};
+use crate::reel::{Reel, ReelDrive, ReelSaturation};
 use crate::scenario::Scenario;
 use tss_reel::controller::{
-    Config, ConfigError, Controller, Envelope, Input, MonitorConfig, Output, Phase, Stage1Config,
+    Config, ConfigError, Controller, Input, MonitorConfig, Output, Phase, Stage1Config,
     Stage2Config,
 };
 use tss_reel::law::Gains;
@@ -88,12 +88,7 @@ pub fn controller_config<T: Real>(sc: &Scenario) -> Result<Config<T>, SimError> 
             start_tick: Some(stage2_tick),
         },
         keep_capture_m: f(sc.controller.keep_capture_m),
-        envelope: Envelope {
-            max_rate_mps: f(sc.envelope.max_rate_mps),
-            max_accel_mps2: f(sc.envelope.max_accel_mps2),
-            min_length_m: f(sc.envelope.min_length_m),
-            max_length_m: f(sc.envelope.max_length_m),
-        },
+        envelope: sc.envelope.to_envelope(),
         monitor: monitor_config(sc),
     })
 }
@@ -241,10 +236,10 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
         probes: Vec::with_capacity(probes.len()),
         ..History::default()
     };
-    let mut injector = Injector::new(sc);
-    let mut reel = Reel::new(&sc.reel, sc.initial.length_rate_mps);
+    let mut injector = Injector::new(&InjectionPlan::from(sc), period);
+    let mut reel = Reel::new(&ReelDrive::from(&sc.reel), sc.initial.length_rate_mps);
     let ideal_reel = reel.is_ideal();
-    let mut summary = SummaryBuilder::new(period, &sc.envelope);
+    let mut summary = SummaryBuilder::new(period, &sc.envelope.to_envelope());
     let mut next_probe = 0;
     for tick in 0..=total {
         let t_s = f64::from(tick) * period;

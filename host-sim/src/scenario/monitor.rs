@@ -1,0 +1,76 @@
+//! `[monitor]`: the thresholds of the controller's sensor monitor.
+
+use serde::{Deserialize, Serialize};
+
+use super::rules::{num, Validator};
+
+/// `[monitor]`: the controller's sensor checks and fault timing (`tss_reel`'s `MonitorConfig`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MonitorSection {
+    /// Ticks without a usable sample during which the controller coasts before safe hold.
+    pub coast_ticks: u32,
+    /// Consecutive valid samples needed to leave safe hold.
+    pub recovery_ticks: u32,
+    /// Largest accepted |sensed − predicted| length, m.
+    pub length_jump_m: f64,
+    /// Largest accepted α jump per tick beyond α̇·Δt, rad.
+    pub alpha_jump_rad: f64,
+    /// Identical α readings in a row (with α̇ implying motion) that make a stuck sensor.
+    pub stuck_ticks: u32,
+    /// Implied motion ∫|α̇|dt over the identical readings a stuck verdict needs, rad.
+    pub stuck_motion_rad: f64,
+    /// Largest plausible |α̇|, rad/s.
+    pub max_alpha_rate_radps: f64,
+    /// Smallest plausible orbit rate, rad/s.
+    pub min_orbit_rate_radps: f64,
+    /// Largest plausible orbit rate, rad/s.
+    pub max_orbit_rate_radps: f64,
+}
+
+impl Default for MonitorSection {
+    fn default() -> Self {
+        let m = tss_reel::controller::MonitorConfig::<f64>::default_for_period();
+        Self {
+            coast_ticks: m.coast_ticks,
+            recovery_ticks: m.recovery_ticks,
+            length_jump_m: m.length_jump_m,
+            alpha_jump_rad: m.alpha_jump_rad,
+            stuck_ticks: m.stuck_ticks,
+            stuck_motion_rad: m.stuck_motion_rad,
+            max_alpha_rate_radps: m.max_alpha_rate_radps,
+            min_orbit_rate_radps: m.min_orbit_rate_radps,
+            max_orbit_rate_radps: m.max_orbit_rate_radps,
+        }
+    }
+}
+
+impl MonitorSection {
+    /// The same rules as `MonitorConfig::validate`, named by scenario key.
+    pub(super) fn check(&self, v: &mut Validator) {
+        let m = self;
+        for (field, ticks) in [
+            ("monitor.coast_ticks", m.coast_ticks),
+            ("monitor.recovery_ticks", m.recovery_ticks),
+            ("monitor.stuck_ticks", m.stuck_ticks),
+        ] {
+            v.check(ticks >= 1, field, ticks.to_string(), "must be at least 1");
+        }
+        v.positive("monitor.length_jump_m", m.length_jump_m);
+        v.positive("monitor.alpha_jump_rad", m.alpha_jump_rad);
+        v.positive("monitor.stuck_motion_rad", m.stuck_motion_rad);
+        v.positive("monitor.max_alpha_rate_radps", m.max_alpha_rate_radps);
+        let min_ok = v.positive("monitor.min_orbit_rate_radps", m.min_orbit_rate_radps);
+        if v.positive("monitor.max_orbit_rate_radps", m.max_orbit_rate_radps) && min_ok {
+            v.check(
+                m.max_orbit_rate_radps > m.min_orbit_rate_radps,
+                "monitor.max_orbit_rate_radps",
+                num(m.max_orbit_rate_radps),
+                &format!(
+                    "must be above monitor.min_orbit_rate_radps = {}",
+                    num(m.min_orbit_rate_radps)
+                ),
+            );
+        }
+    }
+}

@@ -1,0 +1,110 @@
+//! `[orbit]`, `[masses]`, `[tether]`: the physical system the controller flies (Eq. 5 of the
+//! paper), and the rules that keep it physical.
+
+use serde::{Deserialize, Serialize};
+
+use super::envelope::EnvelopeSection;
+use super::rules::{num, Validator};
+
+/// Equatorial radius of the Earth (WGS-84), m: the orbit's perigee must lie above it.
+pub const EARTH_EQUATORIAL_RADIUS_M: f64 = 6_378_137.0;
+
+/// `[orbit]`
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OrbitSection {
+    /// Semi-major axis a (the radius of a circular orbit), m.
+    pub semi_major_axis_m: f64,
+    /// Eccentricity e, in [0, 1).
+    #[serde(default)]
+    pub eccentricity: f64,
+    /// True anomaly θ at t = 0, rad.
+    #[serde(default)]
+    pub initial_true_anomaly_rad: f64,
+}
+
+impl OrbitSection {
+    /// a > 0, e in [0, 1), θ(0) finite, and the perigee a(1 − e) above the Earth's surface.
+    pub(super) fn check(&self, v: &mut Validator) {
+        let o = self;
+        v.positive("orbit.semi_major_axis_m", o.semi_major_axis_m);
+        if v.finite("orbit.eccentricity", o.eccentricity) {
+            v.check(
+                (0.0..1.0).contains(&o.eccentricity),
+                "orbit.eccentricity",
+                num(o.eccentricity),
+                "must be in [0, 1)",
+            );
+        }
+        v.finite("orbit.initial_true_anomaly_rad", o.initial_true_anomaly_rad);
+        if o.semi_major_axis_m.is_finite()
+            && o.semi_major_axis_m > 0.0
+            && (0.0..1.0).contains(&o.eccentricity)
+        {
+            let perigee_m = o.semi_major_axis_m * (1.0 - o.eccentricity);
+            v.check(
+                perigee_m > EARTH_EQUATORIAL_RADIUS_M,
+                "orbit.semi_major_axis_m",
+                num(o.semi_major_axis_m),
+                &format!(
+                    "puts the perigee a(1 − e) = {} m (orbit.eccentricity = {}) inside the Earth \
+                     (radius {EARTH_EQUATORIAL_RADIUS_M} m)",
+                    num(perigee_m),
+                    num(o.eccentricity)
+                ),
+            );
+        }
+    }
+}
+
+/// `[masses]`
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MassesSection {
+    /// m01, main satellite with the whole tether on the reel, kg.
+    pub main_initial_kg: f64,
+    /// m2, sub-satellite, kg.
+    pub sub_kg: f64,
+}
+
+impl MassesSection {
+    /// Both masses above 0.
+    pub(super) fn check(&self, v: &mut Validator) {
+        v.positive("masses.main_initial_kg", self.main_initial_kg);
+        v.positive("masses.sub_kg", self.sub_kg);
+    }
+}
+
+/// `[tether]`
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TetherSection {
+    /// ρ, linear density, kg/m (0 = massless, the paper's run).
+    #[serde(default)]
+    pub density_kg_per_m: f64,
+}
+
+impl TetherSection {
+    /// ρ ≥ 0, and the tether never outweighs the main satellite, even paid out to the longest
+    /// length the envelope allows.
+    pub(super) fn check(&self, masses: &MassesSection, env: &EnvelopeSection, v: &mut Validator) {
+        if v.non_negative("tether.density_kg_per_m", self.density_kg_per_m) {
+            let longest_m = env.max_length_m;
+            let tether_kg = self.density_kg_per_m * longest_m;
+            if env.max_length_valid() && masses.main_initial_kg.is_finite() {
+                v.check(
+                    tether_kg < masses.main_initial_kg,
+                    "tether.density_kg_per_m",
+                    num(self.density_kg_per_m),
+                    &format!(
+                        "makes the tether at envelope.max_length_m = {} m weigh {} kg, not \
+                         below masses.main_initial_kg = {}",
+                        num(longest_m),
+                        num(tether_kg),
+                        num(masses.main_initial_kg)
+                    ),
+                );
+            }
+        }
+    }
+}
