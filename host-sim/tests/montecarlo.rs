@@ -453,7 +453,11 @@ fn a_campaign_replaces_an_earlier_campaigns_files() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("mc");
     std::fs::create_dir_all(&out).unwrap();
-    for f in ["mc_histograms.png", "mc_scatter_keep1_max_error_m.svg", "notes.md"] {
+    for f in [
+        "mc_histograms.png",
+        "mc_scatter_keep1_max_error_m.svg",
+        "notes.md",
+    ] {
         std::fs::write(out.join(f), "earlier").unwrap();
     }
     campaign(&out, 2, 7, &SHORT);
