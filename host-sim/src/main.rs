@@ -5,8 +5,8 @@
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
-use tss_sim::{analysis, montecarlo, run_cmd};
+use clap::{CommandFactory, Parser, Subcommand};
+use tss_sim::{analysis, montecarlo, run_cmd, usage};
 
 /// Exit code for usage errors (as clap uses for bad arguments).
 const EXIT_USAGE: u8 = 2;
@@ -20,6 +20,10 @@ const EXIT_FAILURE: u8 = 1;
     about = "Desktop simulator of the tss-reel controller (He, Liang & Xu 2011)"
 )]
 struct Cli {
+    /// Print nothing on stdout and draw no progress bar (errors still go to stderr; the files
+    /// are written as usual).
+    #[arg(long, short, global = true)]
+    quiet: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -38,22 +42,38 @@ enum Command {
     Montecarlo(montecarlo::MonteCarloArgs),
     /// Combine the output directories of `montecarlo --shard K/N` into the whole campaign's.
     Merge(montecarlo::MergeArgs),
+    /// Print a shell completion script, e.g. `tss-sim completions bash > tss-sim.bash`.
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    usage::set_quiet(cli.quiet);
     let result = match cli.command {
         Command::Run(args) => run_cmd::run(args),
         Command::Extent(args) => analysis::run_extent(&args),
         Command::Stability(args) => analysis::run_stability(&args),
         Command::Montecarlo(args) => montecarlo::montecarlo(&args),
         Command::Merge(args) => montecarlo::merge(&args),
+        Command::Completions { shell } => {
+            clap_complete::generate(
+                shell,
+                &mut Cli::command(),
+                "tss-sim",
+                &mut std::io::stdout(),
+            );
+            Ok(())
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
             eprintln!("error: {err:#}");
-            if run_cmd::is_usage_error(&err) || analysis::is_usage_error(&err) {
+            if usage::is_usage_error(&err) || analysis::is_usage_error(&err) {
                 ExitCode::from(EXIT_USAGE)
             } else {
                 ExitCode::from(EXIT_FAILURE)

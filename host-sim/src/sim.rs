@@ -232,7 +232,7 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
     let progress_every = ticks("progress", 60.0, period).unwrap_or(60).max(1);
 
     let mut history = History {
-        samples: Vec::with_capacity((total / every) as usize + 2),
+        samples: Vec::new(), // grown as written: never sized from the asked duration
         probes: Vec::with_capacity(probes.len()),
         ..History::default()
     };
