@@ -32,6 +32,7 @@
 
 mod control;
 mod convert;
+mod core_rules;
 mod envelope;
 mod error;
 mod initial;
@@ -127,28 +128,25 @@ pub struct Scenario {
 
 impl Scenario {
     /// Checks that the scenario makes physical sense; returns every failed rule (empty =
-    /// valid), section by section, in the order of the file's fields.
+    /// valid): the scenario's own rules section by section, then the first rule of the flight
+    /// controller's configuration (built in f32, as flown) that fails.
     pub fn problems(&self) -> Vec<Problem> {
         let mut v = Validator::default();
         let s = self;
         s.check_name(&mut v);
         s.orbit.check(&mut v);
-        s.masses.check(&mut v);
         s.initial.check(&mut v);
-        s.controller.check(&mut v);
-        s.envelope.check(&mut v);
         s.initial.check_within(&s.envelope, &mut v);
         s.stage1.check(&mut v);
         s.stage2.check(&s.stage1, s.controller.period_s, &mut v);
-        control::check_keeps_within(&s.stage1, &s.stage2, &s.envelope, &mut v);
-        s.tether.check(&s.masses, &s.envelope, &mut v);
         s.simulation.check(s.controller.period_s, &mut v);
         s.montecarlo.check(s, &mut v);
         s.sensors.check(&mut v);
         s.faults.check(&mut v);
         s.reel.check(&mut v);
-        s.monitor.check(&mut v);
         s.link.check(&mut v);
+        // The flight controller's own rules, last (it reports the first it finds).
+        core_rules::check(s, &mut v);
         v.problems
     }
 
