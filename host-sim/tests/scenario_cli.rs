@@ -123,6 +123,16 @@ fn a_physically_invalid_value_exits_2() {
     );
 }
 
+/// Used to abort on a 48 GB allocation: now a usage error before any work.
+#[test]
+fn a_run_too_long_for_the_simulator_exits_2() {
+    rejected(
+        &paper(),
+        &["--set", "simulation.duration_s=4294967295"],
+        &["paper.toml: simulation.duration_s = 4294967295 is 4294967295 control periods, more than the simulator's 10000000"],
+    );
+}
+
 #[test]
 fn a_value_that_overflows_the_controllers_f32_exits_2() {
     rejected(

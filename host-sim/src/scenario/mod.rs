@@ -67,9 +67,11 @@ pub use reel::ReelSection;
 pub use schema::{schema, LeafKind, Schema};
 pub use sensors::{
     CorruptSection, FaultsSection, GlitchSection, SensorName, SensorSection, SensorsSection,
-    WindowSection,
+    WindowSection, MAX_FAULT_ENTRIES,
 };
-pub use simulation::{SimulationSection, MAX_TICKS};
+pub use simulation::{
+    SimulationSection, MAX_HISTORY_ROWS, MAX_PLANT_STEPS, MAX_SUBSTEPS, MAX_TICKS,
+};
 pub use system::{MassesSection, OrbitSection, TetherSection, EARTH_EQUATORIAL_RADIUS_M};
 
 use rules::Validator;
@@ -144,6 +146,7 @@ impl Scenario {
         s.sensors.check(&mut v);
         s.faults.check(&mut v);
         s.reel.check(&mut v);
+        s.monitor.check(&mut v);
         s.link.check(&mut v);
         // The flight controller's own rules, last (it reports the first it finds).
         core_rules::check(s, &mut v);

@@ -3,6 +3,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::rules::Validator;
+use super::simulation::MAX_TICKS;
+
 /// `[monitor]`: the controller's sensor checks and fault timing (`tss_reel`'s `MonitorConfig`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -40,6 +43,25 @@ impl Default for MonitorSection {
             max_alpha_rate_radps: m.max_alpha_rate_radps,
             min_orbit_rate_radps: m.min_orbit_rate_radps,
             max_orbit_rate_radps: m.max_orbit_rate_radps,
+        }
+    }
+}
+
+impl MonitorSection {
+    /// Tick counts within the longest run, [`MAX_TICKS`] (their other rules, ≥ 1 and the
+    /// thresholds, are the controller's: `MonitorConfig::validate`).
+    pub(super) fn check(&self, v: &mut Validator) {
+        for (field, ticks) in [
+            ("monitor.coast_ticks", self.coast_ticks),
+            ("monitor.recovery_ticks", self.recovery_ticks),
+            ("monitor.stuck_ticks", self.stuck_ticks),
+        ] {
+            v.check(
+                ticks <= MAX_TICKS,
+                field,
+                ticks.to_string(),
+                &format!("must be at most {MAX_TICKS} (the longest run, in ticks)"),
+            );
         }
     }
 }

@@ -181,8 +181,21 @@ impl MonteCarloSection {
                 from_override: false,
             });
         };
-        if !mc.dispersion.is_empty() {
-            let fields = dispersible_fields();
+        let fields = dispersible_fields();
+        // One dispersion per number field at most (a field is dispersed once).
+        let count_ok = mc.dispersion.len() <= fields.len();
+        if !count_ok {
+            bad(
+                "montecarlo.dispersion".to_string(),
+                format!("[{} entries]", mc.dispersion.len()),
+                format!(
+                    "has more entries than the scenario's {} number fields (each is dispersed \
+                     at most once)",
+                    fields.len()
+                ),
+            );
+        }
+        if count_ok && !mc.dispersion.is_empty() {
             let table = toml::Table::try_from(sc).ok();
             let mut seen: Vec<&str> = Vec::new();
             for (i, d) in mc.dispersion.iter().enumerate() {

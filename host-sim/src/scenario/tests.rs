@@ -587,3 +587,89 @@ fn values_that_overflow_the_controllers_f32_are_rejected() {
         "{e}"
     );
 }
+
+/// Every size has a bound, checked at load (before any work), naming the field and value.
+/// `simulation.duration_s = 4294967295` used to pass and abort the run on a 48 GB allocation.
+#[test]
+fn every_size_and_count_has_a_bound() {
+    let window = "{ from_s = 1, until_s = 2 }";
+    let many = |n: usize| vec![window; n].join(", ");
+    let dropouts = format!("faults.dropout=[{}]", many(MAX_FAULT_ENTRIES + 1));
+    let cases: Vec<(Vec<String>, &str, &str)> = vec![
+        (
+            vec!["simulation.duration_s=4294967295".into()],
+            "simulation.duration_s = 4294967295 is 4294967295 control periods, more than the simulator's 10000000",
+            "",
+        ),
+        (
+            vec!["simulation.substeps=1001".into()],
+            "simulation.substeps = 1001 must be at most 1000",
+            "",
+        ),
+        (
+            vec![
+                "simulation.duration_s=200000".into(),
+                "simulation.substeps=1000".into(),
+            ],
+            "simulation.substeps = 1000 makes 200000000 plant steps",
+            "more than the simulator's 100000000",
+        ),
+        (
+            vec![
+                "simulation.duration_s=2000000".into(),
+                "simulation.output_interval_s=1".into(),
+            ],
+            "simulation.output_interval_s = 1 makes 2000001 rows of history",
+            "more than the simulator's 1000000",
+        ),
+        (
+            vec![dropouts],
+            "faults.dropout = [1001 entries] has more entries than the simulator's 1000",
+            "",
+        ),
+        (
+            vec!["monitor.coast_ticks=10000001".into()],
+            "monitor.coast_ticks = 10000001 must be at most 10000000",
+            "",
+        ),
+    ];
+    for (sets, head, rest) in cases {
+        let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+        let e = err(&sets);
+        let line = e
+            .lines()
+            .find(|l| l.starts_with(&format!("{FILE}: {head}")))
+            .unwrap_or_else(|| panic!("no {head:?} in {e}"));
+        assert!(line.contains(rest), "{line}");
+        // A list beyond its bound is one problem, not one per entry.
+        assert!(e.lines().count() <= 2, "{e}");
+    }
+    // At the bounds, accepted.
+    load(&["simulation.substeps=1000"]).unwrap();
+    load(&[&format!("faults.dropout=[{}]", many(MAX_FAULT_ENTRIES))]).unwrap_or_else(|e| {
+        // Identical windows are valid; only the count is under test.
+        panic!("{e}")
+    });
+    load(&[
+        "simulation.duration_s=999990",
+        "simulation.output_interval_s=1",
+    ])
+    .unwrap();
+}
+
+#[test]
+fn a_campaign_disperses_each_field_at_most_once() {
+    let n = dispersible_fields().len() + 1;
+    let entry = "[[montecarlo.dispersion]]\nfield = \"masses.sub_kg\"\ndistribution = \"normal\"\nstd = 1.0\n";
+    let text = format!("{BASE}{}", entry.repeat(n));
+    let e = Scenario::from_toml_str(&text, FILE, &[])
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        e,
+        format!(
+            "{FILE}: montecarlo.dispersion = [{n} entries] has more entries than the scenario's {} number fields (each is dispersed at most once)",
+            n - 1
+        )
+    );
+}
