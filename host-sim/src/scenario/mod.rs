@@ -15,7 +15,9 @@
 //!   ([`Scenario::load`]);
 //! - `convert.rs`: the scenario turned into the parameter types of the models it configures
 //!   (the physics never reads the schema);
-//! - `error.rs`: errors that name the file, the field and the value ([`ScenarioError`]).
+//! - `error.rs`: errors that name the file, the field and the value ([`ScenarioError`]);
+//! - [`keys`]: `tss-sim scenario keys`, every key with its unit, default and rules, read from
+//!   the schema and from validation itself.
 //!
 //! # Adding a section, say `[environment]`
 //! 1. A file `environment.rs` with `pub struct EnvironmentSection` (`#[derive(Clone, Debug,
@@ -36,6 +38,7 @@ mod core_rules;
 mod envelope;
 mod error;
 mod initial;
+pub mod keys;
 mod link;
 mod load;
 mod monitor;
