@@ -103,8 +103,11 @@ impl From<&SensorSection> for SensorErrors {
             noise_std: s.noise_std,
             bias: s.bias,
             quantum: s.quantum,
-            stuck_from_s: s.stuck_from_s,
-            stuck_until_s: s.stuck_until_s,
+            // `stuck_from_s = inf` (the default) is never.
+            stuck: (s.stuck_from_s != f64::INFINITY).then_some(Window {
+                from_s: s.stuck_from_s,
+                until_s: s.stuck_until_s,
+            }),
         }
     }
 }

@@ -673,3 +673,38 @@ fn a_campaign_disperses_each_field_at_most_once() {
         )
     );
 }
+
+/// The models' parameter types mean what the sections' defaults mean: a perfect sensor, an
+/// ideal reel, nothing injected; a stuck window from its start to its end.
+#[test]
+fn conversions_keep_the_meaning_of_the_defaults() {
+    use crate::faults::{InjectionPlan, SensorErrors, Window};
+    use crate::reel::ReelDrive;
+    let s = load(&[]).unwrap();
+    assert!(InjectionPlan::from(&s).is_transparent());
+    assert!(ReelDrive::from(&s.reel).is_ideal());
+    assert_eq!(
+        SensorErrors::from(&SensorSection::default()),
+        SensorErrors::default()
+    );
+    let s = load(&[
+        "sensors.alpha.stuck_from_s=50",
+        "sensors.length.bias=0.5",
+        "reel.lag_s=2",
+    ])
+    .unwrap();
+    let plan = InjectionPlan::from(&s);
+    assert_eq!(
+        plan.alpha.stuck,
+        Some(Window {
+            from_s: 50.0,
+            until_s: f64::INFINITY
+        })
+    );
+    assert_eq!(plan.length.bias, 0.5);
+    assert!(!plan.is_transparent());
+    assert!(!ReelDrive::from(&s.reel).is_ideal());
+    let cfg = s.controller_config::<f32>();
+    assert_eq!(cfg.stage2.start_tick, Some(28_800));
+    assert_eq!(cfg.envelope.max_rate_mps, 10.0);
+}
