@@ -8,6 +8,9 @@
 //!   `[tether]`), `initial.rs`, `control.rs` (`[controller]`, `[stage1]`, `[stage2]`),
 //!   `envelope.rs`, `monitor.rs`, `simulation.rs`, `sensors.rs` (`[sensors]`, `[faults]`),
 //!   `reel.rs`, `link.rs`, `montecarlo.rs`;
+//! - `core_rules.rs`: the flight controller's own rules, not repeated here: the f32 controller
+//!   is built from the scenario and the parameter path of what it rejects is named by scenario
+//!   key (this also catches values beyond f32's range);
 //! - `rules.rs`: the `Validator` the rules are written with (each failed rule a [`Problem`]);
 //! - `schema.rs`: every key with its type, traced from the structs (no hand-written list;
 //!   [`schema()`]);
@@ -28,9 +31,12 @@
 //!    `pub environment: EnvironmentSection` in [`Scenario`], and a line in
 //!    [`Scenario::problems`] calling its `check`.
 //! 3. If a model takes it, a conversion in `convert.rs` into that model's own parameter type.
+//!    If it configures the flight controller, its rules are `Config::validate`'s: map the
+//!    controller's parameter path to the key in `core_rules.rs` instead of repeating them.
+//! 4. A count or size gets a documented bound (a `MAX_…` constant) checked in its `check`.
 //!
-//! The schema, `--set`, Monte Carlo dispersions and the resolved `scenario.toml` a run writes
-//! follow from the struct by themselves.
+//! The schema, `--set`, Monte Carlo dispersions, `tss-sim scenario keys` and the resolved
+//! `scenario.toml` a run writes follow from the struct by themselves.
 
 mod control;
 mod convert;
