@@ -6,7 +6,7 @@
 use std::process::ExitCode;
 
 use clap::{CommandFactory, Parser, Subcommand};
-use tss_sim::{analysis, montecarlo, run_cmd, usage};
+use tss_sim::{analysis, montecarlo, run_cmd, scenario, usage};
 
 /// Exit code for usage errors (as clap uses for bad arguments).
 const EXIT_USAGE: u8 = 2;
@@ -48,6 +48,42 @@ enum Command {
         #[arg(value_enum)]
         shell: clap_complete::Shell,
     },
+    /// Scenario files: `scenario keys` lists every key with its unit, default and rules.
+    #[command(subcommand)]
+    Scenario(ScenarioCommand),
+}
+
+#[derive(Subcommand, Debug)]
+enum ScenarioCommand {
+    /// Every scenario key with its type, unit, default and the rules validation enforces (read
+    /// from the schema and from validation itself).
+    Keys {
+        /// `text` (a key per line, its rules indented) or `tsv` (one line per key).
+        #[arg(long, value_enum, default_value_t = KeysFormat::Text)]
+        format: KeysFormat,
+    },
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum KeysFormat {
+    Text,
+    Tsv,
+}
+
+fn scenario_command(command: &ScenarioCommand) -> anyhow::Result<()> {
+    match command {
+        ScenarioCommand::Keys { format } => {
+            let keys = scenario::keys::keys();
+            print!(
+                "{}",
+                match format {
+                    KeysFormat::Text => scenario::keys::render_text(&keys),
+                    KeysFormat::Tsv => scenario::keys::render_tsv(&keys),
+                }
+            );
+            Ok(())
+        }
+    }
 }
 
 fn main() -> ExitCode {
@@ -68,6 +104,7 @@ fn main() -> ExitCode {
             );
             Ok(())
         }
+        Command::Scenario(command) => scenario_command(&command),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

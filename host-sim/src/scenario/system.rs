@@ -1,9 +1,10 @@
 //! `[orbit]`, `[masses]`, `[tether]`: the physical system the controller flies (Eq. 5 of the
-//! paper), and the rules that keep it physical.
+//! paper). The masses' and the tether's rules (positive masses, ρ ≥ 0, a tether lighter than
+//! the main satellite) are the controller's (`core_rules.rs`); the orbit's perigee is the
+//! scenario's.
 
 use serde::{Deserialize, Serialize};
 
-use super::envelope::EnvelopeSection;
 use super::rules::{num, Validator};
 
 /// Equatorial radius of the Earth (WGS-84), m: the orbit's perigee must lie above it.
@@ -24,18 +25,10 @@ pub struct OrbitSection {
 }
 
 impl OrbitSection {
-    /// a > 0, e in [0, 1), θ(0) finite, and the perigee a(1 − e) above the Earth's surface.
+    /// θ(0) finite, and the perigee a(1 − e) above the Earth's surface (a > 0 and the range
+    /// of e are the controller's rules).
     pub(super) fn check(&self, v: &mut Validator) {
         let o = self;
-        v.positive("orbit.semi_major_axis_m", o.semi_major_axis_m);
-        if v.finite("orbit.eccentricity", o.eccentricity) {
-            v.check(
-                (0.0..1.0).contains(&o.eccentricity),
-                "orbit.eccentricity",
-                num(o.eccentricity),
-                "must be in [0, 1)",
-            );
-        }
         v.finite("orbit.initial_true_anomaly_rad", o.initial_true_anomaly_rad);
         if o.semi_major_axis_m.is_finite()
             && o.semi_major_axis_m > 0.0
@@ -67,14 +60,6 @@ pub struct MassesSection {
     pub sub_kg: f64,
 }
 
-impl MassesSection {
-    /// Both masses above 0.
-    pub(super) fn check(&self, v: &mut Validator) {
-        v.positive("masses.main_initial_kg", self.main_initial_kg);
-        v.positive("masses.sub_kg", self.sub_kg);
-    }
-}
-
 /// `[tether]`
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -82,29 +67,4 @@ pub struct TetherSection {
     /// ρ, linear density, kg/m (0 = massless, the paper's run).
     #[serde(default)]
     pub density_kg_per_m: f64,
-}
-
-impl TetherSection {
-    /// ρ ≥ 0, and the tether never outweighs the main satellite, even paid out to the longest
-    /// length the envelope allows.
-    pub(super) fn check(&self, masses: &MassesSection, env: &EnvelopeSection, v: &mut Validator) {
-        if v.non_negative("tether.density_kg_per_m", self.density_kg_per_m) {
-            let longest_m = env.max_length_m;
-            let tether_kg = self.density_kg_per_m * longest_m;
-            if env.max_length_valid() && masses.main_initial_kg.is_finite() {
-                v.check(
-                    tether_kg < masses.main_initial_kg,
-                    "tether.density_kg_per_m",
-                    num(self.density_kg_per_m),
-                    &format!(
-                        "makes the tether at envelope.max_length_m = {} m weigh {} kg, not \
-                         below masses.main_initial_kg = {}",
-                        num(longest_m),
-                        num(tether_kg),
-                        num(masses.main_initial_kg)
-                    ),
-                );
-            }
-        }
-    }
 }
