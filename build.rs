@@ -2,17 +2,23 @@
 //!
 //! cortex-m-rt's `link.x` does `INCLUDE memory.x`; the linker looks for it on its search path,
 //! so for a bare-metal firmware build we copy the board's map to `OUT_DIR` as `memory.x` and add
-//! that directory to the path. Host builds (the library's tests, the simulator) and builds of
+//! that directory to the path. No file named `memory.x` may sit at the package root: the linker
+//! runs there and looks in its current directory first, so that file would win over the
+//! board's (each board's map is `memory-<board>.x`). Host builds (the library's tests, the simulator) and builds of
 //! the library alone link nothing with it and skip this.
 
 use std::env;
 use std::fs;
 use std::path::PathBuf;
 
-/// The memory map of each board, by the package feature that builds its firmware. One board
-/// today: QEMU's `mps2-an386` with the flight part's budget. A second board adds its feature
-/// and its map here (cargo sets `CARGO_FEATURE_<NAME>` for each enabled feature).
-const BOARDS: &[(&str, &str)] = &[("CARGO_FEATURE_FIRMWARE", "memory.x")];
+/// The memory map of each board, by the package feature that builds its firmware (cargo sets
+/// `CARGO_FEATURE_<NAME>` for each enabled feature): QEMU's `mps2-an386` with the flight part's
+/// budget, and the NUCLEO-G474RE board (STM32G474RE). Another board adds its feature and its map
+/// here (docs/porting.md).
+const BOARDS: &[(&str, &str)] = &[
+    ("CARGO_FEATURE_FIRMWARE", "memory-mps2-an386.x"),
+    ("CARGO_FEATURE_NUCLEO_G474RE", "memory-nucleo-g474re.x"),
+];
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
@@ -23,12 +29,20 @@ fn main() {
     if env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
         return;
     }
-    let Some((_, map)) = BOARDS
+    let mut enabled = BOARDS
         .iter()
-        .find(|(feature, _)| env::var_os(feature).is_some())
-    else {
+        .filter(|(feature, _)| env::var_os(feature).is_some());
+    let Some((feature, map)) = enabled.next() else {
         return;
     };
+    // One firmware per build: two boards would link two memory maps, runtimes and loggers.
+    if let Some((other, _)) = enabled.next() {
+        panic!(
+            "two board features enabled ({} and {}): build one board at a time",
+            feature_name(feature),
+            feature_name(other)
+        );
+    }
 
     let out_dir = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
     let manifest_dir =
@@ -37,4 +51,11 @@ fn main() {
     fs::copy(&memory_x, out_dir.join("memory.x"))
         .unwrap_or_else(|e| panic!("cannot copy {} to OUT_DIR: {e}", memory_x.display()));
     println!("cargo:rustc-link-search={}", out_dir.display());
+}
+
+/// The package feature behind a `CARGO_FEATURE_*` variable, as written in Cargo.toml.
+fn feature_name(var: &str) -> String {
+    var.trim_start_matches("CARGO_FEATURE_")
+        .to_ascii_lowercase()
+        .replace('_', "-")
 }
