@@ -1,11 +1,11 @@
 //! Build script of the `tss-reel` package: makes the board's memory map visible to the linker.
 //!
-//! cortex-m-rt's `link.x` does `INCLUDE memory.x`; the linker looks for it on its search path,
-//! so for a bare-metal firmware build we copy the board's map to `OUT_DIR` as `memory.x` and add
-//! that directory to the path. No file named `memory.x` may sit at the package root: the linker
-//! runs there and looks in its current directory first, so that file would win over the
-//! board's (each board's map is `memory-<board>.x`). Host builds (the library's tests, the simulator) and builds of
-//! the library alone link nothing with it and skip this.
+//! cortex-m-rt's `link.x` does `INCLUDE memory.x`, and the package root's `memory.x` does
+//! `INCLUDE board-memory.x`: for a bare-metal firmware build we copy the board's map
+//! (`memory-<board>.x`) to `OUT_DIR` as `board-memory.x` and add that directory to the linker's
+//! search path. (The linker runs in the package root and looks in its working directory first,
+//! which is why the boards' maps have names of their own.) Host builds (the library's tests, the
+//! simulator) and builds of the library alone link nothing with it and skip this.
 
 use std::env;
 use std::fs;
@@ -22,6 +22,7 @@ const BOARDS: &[(&str, &str)] = &[
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
+    println!("cargo:rerun-if-changed=memory.x");
     for (_, map) in BOARDS {
         println!("cargo:rerun-if-changed={map}");
     }
@@ -48,7 +49,7 @@ fn main() {
     let manifest_dir =
         PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
     let memory_x = manifest_dir.join(map);
-    fs::copy(&memory_x, out_dir.join("memory.x"))
+    fs::copy(&memory_x, out_dir.join("board-memory.x"))
         .unwrap_or_else(|e| panic!("cannot copy {} to OUT_DIR: {e}", memory_x.display()));
     println!("cargo:rustc-link-search={}", out_dir.display());
 }
