@@ -462,3 +462,59 @@ fn the_exact_gravity_field_moves_the_stage_1_keep_by_about_a_centimetre() {
     assert!((0.005..0.03).contains(&worst), "{worst} m");
     assert!((5..=20).contains(&delay), "{delay} s");
 }
+
+/// `[plant]`, `[environment]`, the new `[tether]` and `[reel]` keys: validated, overridable
+/// with `--set`, and the rigid plant refuses what only the elastic one has.
+#[test]
+fn scenario_keys_of_the_elastic_plant_are_validated() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper.toml");
+    let load = |sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        Scenario::load(&path, &sets)
+    };
+    let sc = load(&[]).unwrap();
+    assert_eq!(sc.plant.model, tss_sim::scenario::PlantModel::Rigid);
+    let sc = load(&[
+        "plant.model=\"elastic\"",
+        "reel.model=\"motor\"",
+        "environment.j2=true",
+    ])
+    .unwrap();
+    let prm = ElasticParams::from(&sc);
+    assert!(matches!(prm.reel.model, ReelModel::Motor(_)) && prm.environment.j2);
+    for bad in [
+        &["reel.model=\"motor\""][..],
+        &["environment.drag=true"],
+        &["plant.model=\"elastic\"", "tether.axial_stiffness_n=0"],
+        &[
+            "plant.model=\"elastic\"",
+            "tether.min_stiffness_length_m=2000",
+        ],
+        &["plant.model=\"elastic\"", "reel.static_nm=0.01"],
+        &["plant.courant=3"],
+        &["plant.shape_interval_s=0.5"],
+        &["environment.main_drag_area_m2=-1"],
+    ] {
+        let err = load(bad).expect_err(&format!("{bad:?} accepted"));
+        let text = format!("{err}");
+        let key = bad.last().unwrap().split('=').next().unwrap();
+        assert!(text.contains(key), "{bad:?}: {text}");
+    }
+}
+
+/// The closed loop flies the elastic plant (`sim::run`): the first 3000 s of paper-elastic,
+/// with the elastic columns and the tether's shapes recorded.
+#[test]
+fn the_loop_flies_the_elastic_plant() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper-elastic.toml");
+    let sets = ["simulation.duration_s=3000".to_string()];
+    let sc = Scenario::load(&path, &sets).unwrap();
+    let h = tss_sim::sim::run(&sc, &[], &mut |_| {}).unwrap();
+    assert_eq!(h.samples.len(), 301);
+    assert_eq!(h.elastic.len(), h.samples.len());
+    assert_eq!(h.shapes.len(), 3); // 0, 1800 s and the end
+    let last = h.samples.last().unwrap();
+    let e = h.elastic.last().unwrap();
+    assert!(last.length_m > 20.0 && (e.range_m - last.length_m).abs() < 0.1);
+    assert!(last.tension_n > 0.0 && e.tension_tip_n > 0.0);
+}

@@ -36,7 +36,8 @@ pub mod environment;
 pub mod reel_drum;
 pub mod tether;
 
-use crate::reel::Reel;
+use crate::plant::{Command, ElasticObservation, Observation, Plant, SensorTruth};
+use crate::reel::{Reel, ReelSaturation};
 use environment::{air_velocity_mps, body_drag_n, cylinder_drag_n, Environment, Vec3};
 use reel_drum::{DrumParams, Motion};
 use tether::{Feed, Layout, TetherParams};
@@ -461,6 +462,9 @@ pub struct ElasticPlant {
     t_s: f64,
     feeds: FeedCounts,
     substeps_last: u32,
+    /// The control period the reel's saturation flags are judged over (the last one stepped;
+    /// 1 s before the first), s.
+    period_hint_s: f64,
     ws: Workspace,
 }
 
@@ -574,6 +578,7 @@ impl ElasticPlant {
             t_s: 0.0,
             feeds: FeedCounts::default(),
             substeps_last: 0,
+            period_hint_s: 1.0,
             ws: Workspace::default(),
         })
     }
@@ -1122,5 +1127,76 @@ fn direction_angles(d: &Vec3, d_rate: &Vec3, e_r: &Vec3, e_th: &Vec3, e_h: &Vec3
         alpha_rate_radps: (x * yd - y * xd) / rho2,
         beta_rad: s.asin(),
         beta_rate_radps: s_rate / (1.0 - s * s).sqrt(),
+    }
+}
+
+impl ElasticPlant {
+    /// `false` once the state stopped being finite.
+    pub fn is_finite(&self) -> bool {
+        self.y.is_finite()
+    }
+
+    /// Which reel limits act on `command_mps` over the next `period_s`: the lag drive's own
+    /// (rate, acceleration), or the motor's torque limit (reported as an acceleration limit).
+    pub fn reel_saturation(&self, command_mps: f64, period_s: f64) -> ReelSaturation {
+        if self.p.reel.locked {
+            return ReelSaturation::default();
+        }
+        match (self.p.reel.model, &self.lag) {
+            (ReelModel::Lag(_), Some(r)) => r.saturation(command_mps, period_s),
+            (ReelModel::Motor(d), _) => {
+                let error = command_mps / d.radius_m - self.y.drum_speed_radps;
+                let demand = d.kp() * error + d.ki() * self.y.drum_integral_rad;
+                ReelSaturation {
+                    rate: false,
+                    accel: demand.abs() > d.max_torque_nm,
+                }
+            }
+            _ => ReelSaturation::default(),
+        }
+    }
+}
+
+impl Plant for ElasticPlant {
+    fn observe(&self, command: &Command) -> Observation {
+        let m = self.measure();
+        let sensed = m.sensed(self.p.sensing);
+        let period = self.period_hint_s;
+        Observation {
+            sensors: SensorTruth {
+                length_m: m.paid_out_m,
+                alpha_rad: sensed.alpha_rad,
+                alpha_rate_radps: sensed.alpha_rate_radps,
+                orbit_rate_radps: m.orbit_rate_radps,
+            },
+            length_m: m.paid_out_m,
+            alpha_rad: m.line.alpha_rad,
+            alpha_rate_radps: m.line.alpha_rate_radps,
+            beta_rad: m.line.beta_rad,
+            tension_n: m.tension_reel_n,
+            reel: self.reel_saturation(command.rate_mps, period),
+            elastic: Some(ElasticObservation {
+                range_m: m.range_m,
+                tension_tip_n: m.tension_tip_n,
+                bowing_m: m.bowing_m,
+                alpha_sensed_rad: sensed.alpha_rad,
+                reel_rate_mps: m.reel_rate_mps,
+                beads: m.beads,
+            }),
+        }
+    }
+
+    fn step(&mut self, command: &Command, period_s: f64) {
+        self.period_hint_s = period_s;
+        // A non-finite state ends the period early; `is_finite` reports it to the loop.
+        let _ = ElasticPlant::step(self, command.rate_mps, period_s);
+    }
+
+    fn is_finite(&self) -> bool {
+        ElasticPlant::is_finite(self)
+    }
+
+    fn shape(&self) -> Option<Vec<[f64; 3]>> {
+        Some(self.shape_orbit_frame())
     }
 }
