@@ -219,7 +219,11 @@ where
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let history_csv = dir.join("history.csv");
     write_file(&history_csv, |w| {
-        output::write_history_csv(w, &history.samples)
+        if history.elastic.is_empty() {
+            output::write_history_csv(w, &history.samples)
+        } else {
+            output::write_elastic_history_csv(w, &history.samples, &history.elastic)
+        }
     })?;
     let table = Table1Comparison::new(&history.probes);
     let table1_csv = dir.join("table1.csv");

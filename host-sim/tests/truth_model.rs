@@ -512,9 +512,45 @@ fn the_loop_flies_the_elastic_plant() {
     let h = tss_sim::sim::run(&sc, &[], &mut |_| {}).unwrap();
     assert_eq!(h.samples.len(), 301);
     assert_eq!(h.elastic.len(), h.samples.len());
-    assert_eq!(h.shapes.len(), 3); // 0, 1800 s and the end
+    assert_eq!(h.shapes.len(), 5); // every 900 s and the end
     let last = h.samples.last().unwrap();
     let e = h.elastic.last().unwrap();
     assert!(last.length_m > 20.0 && (e.range_m - last.length_m).abs() < 0.1);
     assert!(last.tension_n > 0.0 && e.tension_tip_n > 0.0);
+}
+
+/// Verification 5 (long: two 20-h missions; `cargo test --release -p tss-sim --test
+/// truth_model -- --ignored`): doubling the beads of paper-elastic (1400 m → 700 m segments,
+/// 20 → 41 beads at 30 km) changes the mean of each stage's Table-1 lengths by less than 5 m,
+/// and no single Table-1 length by more than 15 m.
+///
+/// Why these amounts: both keeps are limit cycles, not equilibria (stage 1: the bounce and
+/// string modes excited by the deploy, ±40 m of range; stage 2: a slack–snap cycle of the
+/// sub-satellite, ±35 m): the length at one instant depends on the cycle's phase, which is
+/// not a converged quantity, so a pointwise difference is bounded by the cycle's amplitude
+/// (15 m covers the measured 9.1 m), while the stage mean converges (measured 2.7 m and
+/// 0.16 m; 5 m is 0.02 % of 30 km, a sixth of the 30 m static stretch at 10 N).
+#[test]
+#[ignore = "two 20-hour missions: about 5 s in release, minutes in the test profile"]
+fn doubling_the_beads_changes_the_table_1_lengths_by_less_than_the_limit_cycle() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper-elastic.toml");
+    let fly = |segment_m: f64| {
+        let sets = [format!("tether.segment_length_m={segment_m}")];
+        let sc = Scenario::load(&path, &sets).unwrap();
+        tss_sim::sim::run(&sc, &table1_times(), &mut |_| {})
+            .unwrap()
+            .probes
+    };
+    let (coarse, fine) = (fly(1_400.0), fly(700.0));
+    for (stage, range) in [(1, 0..21), (2, 21..42)] {
+        let mean = |p: &[(f64, f64)]| p[range.clone()].iter().map(|x| x.1).sum::<f64>() / 21.0;
+        let d_mean = (mean(&coarse) - mean(&fine)).abs();
+        let worst = range
+            .clone()
+            .map(|k| (coarse[k].1 - fine[k].1).abs())
+            .fold(0.0, f64::max);
+        println!("stage {stage}: |Δ mean| = {d_mean:.3} m, worst |Δ| = {worst:.3} m");
+        assert!(d_mean < 5.0, "stage {stage}: {d_mean}");
+        assert!(worst < 15.0, "stage {stage}: {worst}");
+    }
 }
