@@ -652,6 +652,12 @@ impl ElasticPlant {
             .collect()
     }
 
+    /// The centre of mass's absolute (Earth-centred inertial) position and velocity, m, m/s.
+    pub fn centre_of_mass_state(&self) -> (Vec3, Vec3) {
+        let (r, v, _) = self.centre_of_mass();
+        (r, v)
+    }
+
     /// The centre of mass's absolute position and velocity and the total mass.
     fn centre_of_mass(&self) -> (Vec3, Vec3, f64) {
         let m = self.masses();
