@@ -649,3 +649,25 @@ fn exit_direction_and_line_part_when_the_tether_bows() {
     println!("exit vs line: up to {worst:.4} rad");
     assert!(worst > 1e-3 && worst < 0.5, "{worst}");
 }
+
+/// `reel.locked` holds the drum on either plant: the length never moves, the controller's
+/// commands are still logged.
+#[test]
+fn a_locked_reel_holds_the_length_on_both_plants() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper.toml");
+    for model in ["rigid", "elastic"] {
+        let sets = [
+            "reel.locked=true".to_string(),
+            "initial.length_m=100".to_string(),
+            "simulation.duration_s=600".to_string(),
+            format!("plant.model=\"{model}\""),
+        ];
+        let sc = Scenario::load(&path, &sets).unwrap();
+        let h = tss_sim::sim::run(&sc, &[], &mut |_| {}).unwrap();
+        assert!(h.samples.iter().all(|s| s.length_m == 100.0), "{model}");
+        assert!(
+            h.samples.iter().any(|s| s.length_rate_mps != 0.0),
+            "{model}"
+        );
+    }
+}
