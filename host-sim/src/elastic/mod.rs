@@ -371,6 +371,7 @@ enum ReelDrive {
     Rate(f64),
     /// The drum's speed loop with this speed command, motion and brake.
     Drum {
+        drum: DrumParams,
         command_radps: f64,
         motion: Motion,
         brake: bool,
@@ -447,16 +448,32 @@ struct Workspace {
     masses: Vec<f64>,
 }
 
+/// The reel's state between periods, by model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum ReelState {
+    /// Held still (`reel.locked`), whatever the model.
+    Locked,
+    /// The rate is the command.
+    Ideal,
+    /// The lag drive, with its rate now.
+    Lag(Reel),
+    /// The drum and its stick/slip state (its speed and integral are integrated in [`State`]).
+    Motor {
+        /// Its parameters.
+        drum: DrumParams,
+        /// Stuck or slipping.
+        motion: Motion,
+    },
+}
+
 /// The truth model, stepped one control period at a time.
 #[derive(Clone, Debug)]
 pub struct ElasticPlant {
     p: ElasticParams,
     layout: Layout,
     y: State,
-    /// The drum's stick/slip state (motor reel).
-    motion: Motion,
-    /// The lag drive's state (lag reel).
-    lag: Option<Reel>,
+    /// The reel's own state.
+    reel: ReelState,
     /// The reel's rate at the end of the last period, m/s.
     reel_rate_mps: f64,
     t_s: f64,
@@ -538,23 +555,27 @@ impl ElasticPlant {
 
         let locked = p.reel.locked;
         let rate = if locked { 0.0 } else { init.rate_mps };
-        let (mut speed, mut integral, mut motion, mut lag) = (0.0, 0.0, Motion::Stuck, None);
-        match p.reel.model {
-            ReelModel::Ideal => {}
+        let (mut speed, mut integral) = (0.0, 0.0);
+        let reel = match p.reel.model {
+            _ if locked => ReelState::Locked,
+            ReelModel::Ideal => ReelState::Ideal,
             ReelModel::Lag(mut r) => {
                 r.rate_mps = rate.clamp(-r.max_rate_mps, r.max_rate_mps);
-                lag = Some(r);
+                ReelState::Lag(r)
             }
-            ReelModel::Motor(d) => {
-                speed = rate / d.radius_m;
+            ReelModel::Motor(drum) => {
+                speed = rate / drum.radius_m;
                 // The loop starts holding that speed against the friction (no tension yet).
-                if speed != 0.0 {
-                    motion = Motion::Slipping(speed.signum());
-                    let hold = d.viscous_nms * speed + d.coulomb_nm * speed.signum();
-                    integral = hold / d.ki();
-                }
+                let motion = if speed == 0.0 {
+                    Motion::Stuck
+                } else {
+                    let hold = drum.viscous_nms * speed + drum.coulomb_nm * speed.signum();
+                    integral = hold / drum.ki();
+                    Motion::Slipping(speed.signum())
+                };
+                ReelState::Motor { drum, motion }
             }
-        }
+        };
         let y = State {
             r_ref: r_c,
             v_ref: v_c,
@@ -564,16 +585,15 @@ impl ElasticPlant {
             pos,
             vel,
         };
-        let reel_rate_mps = match (&p.reel.model, lag) {
-            (_, Some(r)) => r.rate_mps,
+        let reel_rate_mps = match reel {
+            ReelState::Lag(r) => r.rate_mps,
             _ => rate,
         };
         Ok(Self {
             p,
             layout,
             y,
-            motion,
-            lag,
+            reel,
             reel_rate_mps,
             t_s: 0.0,
             feeds: FeedCounts::default(),
@@ -754,8 +774,13 @@ impl ElasticPlant {
             range_m: range,
             bowing_m: bowing,
             beads: self.layout.beads,
-            drum_stuck: self.motion == Motion::Stuck
-                && matches!(self.p.reel.model, ReelModel::Motor(_)),
+            drum_stuck: matches!(
+                self.reel,
+                ReelState::Motor {
+                    motion: Motion::Stuck,
+                    ..
+                }
+            ),
         }
     }
 
@@ -765,10 +790,7 @@ impl ElasticPlant {
         self.node_masses(&mut m);
         let t = &self.p.tether;
         let mut fastest: f64 = 0.0;
-        let drum = match (self.p.reel.model, self.p.reel.locked) {
-            (ReelModel::Motor(d), false) => Some(d),
-            _ => None,
-        };
+        let drum = self.drum();
         for s in 0..m.len() - 1 {
             let l = self.layout.segment_m(t, self.y.paid_out_m, s);
             let mut inv_mass = 1.0 / m[s] + 1.0 / m[s + 1];
@@ -794,7 +816,10 @@ impl ElasticPlant {
     pub fn step(&mut self, command_mps: f64, period_s: f64) -> Result<(), ElasticError> {
         check("command_mps", command_mps, true, "finite")?;
         check("period_s", period_s, period_s > 0.0, "> 0")?;
-        let command = if self.p.reel.locked { 0.0 } else { command_mps };
+        let command = match self.reel {
+            ReelState::Locked => 0.0,
+            _ => command_mps,
+        };
         let n = (period_s * self.fastest_rate() / self.p.courant)
             .ceil()
             .max(1.0);
@@ -814,33 +839,53 @@ impl ElasticPlant {
             }
         }
         self.t_s += period_s;
-        self.reel_rate_mps = match (self.p.reel.model, &mut self.lag) {
-            _ if self.p.reel.locked => 0.0,
-            (ReelModel::Ideal, _) => command,
-            (ReelModel::Lag(_), Some(r)) => {
+        self.reel_rate_mps = match &mut self.reel {
+            ReelState::Locked => 0.0,
+            ReelState::Ideal => command,
+            ReelState::Lag(r) => {
                 r.advance(command, period_s);
                 r.rate_mps
             }
-            (ReelModel::Motor(d), _) => d.radius_m * self.y.drum_speed_radps,
-            (ReelModel::Lag(_), None) => unreachable!("a lag reel has its drive state"),
+            ReelState::Motor { drum, .. } => drum.radius_m * self.y.drum_speed_radps,
         };
         Ok(())
     }
 
     /// The reel's drive at `t_in_period_s` into the period under `command`.
     fn drive(&self, command: f64, t_in_period_s: f64, brake: bool) -> ReelDrive {
-        if self.p.reel.locked {
-            return ReelDrive::Rate(0.0);
-        }
-        match (self.p.reel.model, &self.lag) {
-            (ReelModel::Ideal, _) => ReelDrive::Rate(command),
-            (ReelModel::Lag(_), Some(r)) => ReelDrive::Rate(r.rate_after(command, t_in_period_s)),
-            (ReelModel::Lag(_), None) => ReelDrive::Rate(command),
-            (ReelModel::Motor(d), _) => ReelDrive::Drum {
-                command_radps: command / d.radius_m,
-                motion: self.motion,
+        match self.reel {
+            ReelState::Locked => ReelDrive::Rate(0.0),
+            ReelState::Ideal => ReelDrive::Rate(command),
+            ReelState::Lag(r) => ReelDrive::Rate(r.rate_after(command, t_in_period_s)),
+            ReelState::Motor { drum, motion } => ReelDrive::Drum {
+                drum,
+                command_radps: command / drum.radius_m,
+                motion,
                 brake,
             },
+        }
+    }
+
+    /// The drum's parameters, if a motor reel is turning (not locked).
+    fn drum(&self) -> Option<DrumParams> {
+        match self.reel {
+            ReelState::Motor { drum, .. } => Some(drum),
+            _ => None,
+        }
+    }
+
+    /// Sets the drum's stick/slip state (motor reel).
+    fn set_motion(&mut self, to: Motion) {
+        if let ReelState::Motor { motion, .. } = &mut self.reel {
+            *motion = to;
+        }
+    }
+
+    /// The drum's stick/slip state (stuck for every other reel).
+    fn motion(&self) -> Motion {
+        match self.reel {
+            ReelState::Motor { motion, .. } => motion,
+            _ => Motion::Stuck,
         }
     }
 
@@ -848,13 +893,11 @@ impl ElasticPlant {
     /// switch and the feeding rule.
     fn substep(&mut self, command: f64, t0: f64, h: f64) {
         let brake = command == 0.0;
-        let motor = match (self.p.reel.model, self.p.reel.locked) {
-            (ReelModel::Motor(d), false) => Some(d),
-            _ => None,
-        };
+        let motor = self.drum();
         if let Some(d) = motor {
             let drive = self.drum_drive_nm(&d, command);
-            self.motion = d.motion_for_step(self.motion, drive, self.y.drum_speed_radps, brake);
+            let motion = d.motion_for_step(self.motion(), drive, self.y.drum_speed_radps, brake);
+            self.set_motion(motion);
         }
         let speed_start = self.y.drum_speed_radps;
         let mut ws = std::mem::take(&mut self.ws);
@@ -925,13 +968,13 @@ impl ElasticPlant {
         if let Some(d) = motor {
             let drive = self.drum_drive_nm(&d, command);
             let (motion, speed) = d.after_step(
-                self.motion,
+                self.motion(),
                 speed_start,
                 self.y.drum_speed_radps,
                 drive,
                 brake,
             );
-            self.motion = motion;
+            self.set_motion(motion);
             self.y.drum_speed_radps = speed;
         }
         self.feed();
@@ -1004,12 +1047,7 @@ fn derivative(
             motion: Motion::Stuck,
             ..
         } => 0.0,
-        ReelDrive::Drum { .. } => {
-            let ReelModel::Motor(d) = p.reel.model else {
-                unreachable!("a drum drive comes from a motor reel")
-            };
-            d.radius_m * y.drum_speed_radps
-        }
+        ReelDrive::Drum { drum, .. } => drum.radius_m * y.drum_speed_radps,
     };
     dy.r_ref = y.v_ref;
     let g_ref = env.gravity(&y.r_ref);
@@ -1074,13 +1112,11 @@ fn derivative(
     (dy.drum_speed_radps, dy.drum_integral_rad) = match drive {
         ReelDrive::Rate(_) => (0.0, 0.0),
         ReelDrive::Drum {
+            drum: d,
             command_radps,
             motion,
             brake,
         } => {
-            let ReelModel::Motor(d) = p.reel.model else {
-                unreachable!("a drum drive comes from a motor reel")
-            };
             let (torque, integral_rate) =
                 d.speed_loop(command_radps, y.drum_speed_radps, y.drum_integral_rad);
             let drive = torque + d.radius_m * tension_reel;
@@ -1145,12 +1181,9 @@ impl ElasticPlant {
     /// Which reel limits act on `command_mps` over the next `period_s`: the lag drive's own
     /// (rate, acceleration), or the motor's torque limit (reported as an acceleration limit).
     pub fn reel_saturation(&self, command_mps: f64, period_s: f64) -> ReelSaturation {
-        if self.p.reel.locked {
-            return ReelSaturation::default();
-        }
-        match (self.p.reel.model, &self.lag) {
-            (ReelModel::Lag(_), Some(r)) => r.saturation(command_mps, period_s),
-            (ReelModel::Motor(d), _) => {
+        match self.reel {
+            ReelState::Lag(r) => r.saturation(command_mps, period_s),
+            ReelState::Motor { drum: d, .. } => {
                 let error = command_mps / d.radius_m - self.y.drum_speed_radps;
                 let demand = d.kp() * error + d.ki() * self.y.drum_integral_rad;
                 ReelSaturation {
