@@ -12,8 +12,10 @@ case ":$PATH:" in
   *) export PATH="$CARGO_BIN_DIR:$PATH" ;;
 esac
 
-# The firmware's target, its flight build and where that build lands.
+# The firmware's target, the package feature every MCU program needs (Cargo.toml), its flight
+# build and where that build lands.
 FW_TARGET=thumbv7em-none-eabihf
+FW_FEATURES=firmware
 FW_PROFILE=firmware
 # shellcheck disable=SC2034 # used by the scripts that source this file
 FW_ELF=target/$FW_TARGET/$FW_PROFILE/tss-reel
@@ -47,5 +49,5 @@ llvm_tool() {
 
 # Builds the flight firmware (profile `firmware`).
 build_firmware() {
-  cargo build --profile "$FW_PROFILE" --target "$FW_TARGET" --bin tss-reel
+  cargo build --profile "$FW_PROFILE" --target "$FW_TARGET" --features "$FW_FEATURES" --bin tss-reel
 }

@@ -79,7 +79,8 @@ impl Pcg32 {
 
 /// One sensor's errors, in the sensor's own unit (m, rad, rad/s), applied in the order bias,
 /// noise, quantisation, then a stuck window freezes the reading.
-#[derive(Clone, Debug, PartialEq)]
+/// The default is a perfect sensor.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct SensorErrors {
     /// Standard deviation of white Gaussian noise added every sample (0 = none).
     pub noise_std: f64,
@@ -87,32 +88,15 @@ pub struct SensorErrors {
     pub bias: f64,
     /// Quantisation step: the reading is rounded to a multiple of it (0 = none).
     pub quantum: f64,
-    /// The sensor repeats the reading it gave at this time, s (inf = never).
-    pub stuck_from_s: f64,
-    /// … until this time, s (inf = to the end of the run).
-    pub stuck_until_s: f64,
-}
-
-impl Default for SensorErrors {
-    /// A perfect sensor.
-    fn default() -> Self {
-        Self {
-            noise_std: 0.0,
-            bias: 0.0,
-            quantum: 0.0,
-            stuck_from_s: f64::INFINITY,
-            stuck_until_s: f64::INFINITY,
-        }
-    }
+    /// While in this window the sensor repeats the reading it gave at its start (`None`:
+    /// never stuck).
+    pub stuck: Option<Window>,
 }
 
 impl SensorErrors {
     /// `true` if the sensor reads the truth.
     pub fn is_perfect(&self) -> bool {
-        self.noise_std == 0.0
-            && self.bias == 0.0
-            && self.quantum == 0.0
-            && self.stuck_from_s == f64::INFINITY
+        self.noise_std == 0.0 && self.bias == 0.0 && self.quantum == 0.0 && self.stuck.is_none()
     }
 }
 
@@ -259,7 +243,7 @@ impl Channel {
         if c.quantum > 0.0 {
             v = (v / c.quantum).round() * c.quantum;
         }
-        if t_s >= c.stuck_from_s && t_s < c.stuck_until_s {
+        if c.stuck.is_some_and(|w| w.contains(t_s)) {
             *self.held.get_or_insert(v)
         } else {
             self.held = None;
@@ -762,8 +746,8 @@ pub fn injected_faults(setup: &FaultSetup) -> Vec<String> {
         if c.quantum > 0.0 {
             parts.push(format!("quantum {}", c.quantum));
         }
-        if c.stuck_from_s != f64::INFINITY {
-            parts.push(format!("stuck {}", window(c.stuck_from_s, c.stuck_until_s)));
+        if let Some(w) = c.stuck {
+            parts.push(format!("stuck {}", window(w.from_s, w.until_s)));
         }
         if !parts.is_empty() {
             v.push(format!("sensor {name}: {}", parts.join(", ")));
@@ -980,8 +964,10 @@ mod tests {
         let mut c = channel(SensorErrors {
             bias: 0.3,
             quantum: 0.25,
-            stuck_from_s: 2.0,
-            stuck_until_s: 4.0,
+            stuck: Some(Window {
+                from_s: 2.0,
+                until_s: 4.0,
+            }),
             ..SensorErrors::default()
         });
         assert_eq!(c.read(1.0, 0.0), 1.25); // 1.3 → 1.25

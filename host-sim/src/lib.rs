@@ -16,3 +16,4 @@ pub mod run_cmd;
 pub mod scenario;
 pub mod sim;
 pub mod table1;
+pub mod usage;

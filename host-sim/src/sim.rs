@@ -15,12 +15,7 @@ use crate::history::{History, PhaseLabel, Sample};
 use crate::plant::{ix, Command, Observation, Plant, RigidModel, RigidPlant, State};
 use crate::reel::{Reel, ReelDrive};
 use crate::scenario::{PlantModel, Scenario};
-use tss_reel::controller::{
-    Config, ConfigError, Controller, Input, MonitorConfig, Output, Phase, Stage1Config,
-    Stage2Config,
-};
-use tss_reel::law::Gains;
-use tss_reel::mass::MassModel;
+use tss_reel::controller::{Config, ConfigError, Controller, Input, Output, Phase};
 use tss_reel::orbit::Orbit;
 use tss_reel::schedule::BandSchedule;
 use tss_reel::Real;
@@ -55,79 +50,22 @@ pub enum SimError {
     },
 }
 
-/// The controller configuration a scenario describes, in the controller's scalar type.
+/// The controller configuration a scenario describes, in the controller's scalar type
+/// ([`Scenario::controller_config`]), once the stage-2 start is a whole number of periods.
 pub fn controller_config<T: Real>(sc: &Scenario) -> Result<Config<T>, SimError> {
-    let f = T::from_f64;
-    let period = sc.controller.period_s;
-    let stage2_tick = ticks("stage2.start_time_s", sc.stage2.start_time_s, period)?;
-    Ok(Config {
-        period_s: f(period),
-        orbit: Orbit::elliptic(f(sc.orbit.semi_major_axis_m), f(sc.orbit.eccentricity)),
-        masses: mass_model(sc),
-        gains: Gains {
-            k1_per_s: f(sc.controller.k1_per_s),
-            k2_per_s2: f(sc.controller.k2_per_s2),
-        },
-        initial_rate_mps: f(sc.initial.length_rate_mps),
-        stage1: Stage1Config {
-            schedule: BandSchedule {
-                low_length_m: f(sc.stage1.band_start_m),
-                low_angle_rad: f(sc.stage1.deploy_angle_rad),
-                low_slope_rad_per_m: T::ZERO,
-                high_length_m: f(sc.stage1.keep_length_m),
-                high_angle_rad: T::ZERO,
-                high_slope_rad_per_m: f(sc.stage1.keep_slope_rad_per_m),
-            },
-            decay_rate_per_s: f(sc.stage1.decay_rate_per_s),
-        },
-        stage2: Stage2Config {
-            schedule: BandSchedule {
-                low_length_m: f(sc.stage2.keep_length_m),
-                low_angle_rad: T::ZERO,
-                low_slope_rad_per_m: f(sc.stage2.keep_slope_rad_per_m),
-                high_length_m: f(sc.stage2.band_start_m),
-                high_angle_rad: f(sc.stage2.retrieve_angle_rad),
-                high_slope_rad_per_m: T::ZERO,
-            },
-            slew_rate_radps: f(sc.stage2.slew_rate_radps),
-            decay_rate_per_s: f(sc.stage2.decay_rate_per_s),
-            start_tick: Some(stage2_tick),
-        },
-        keep_capture_m: f(sc.controller.keep_capture_m),
-        envelope: sc.envelope.to_envelope(),
-        monitor: monitor_config(sc),
-    })
-}
-
-/// The controller's sensor-monitor thresholds from `[monitor]`.
-pub fn monitor_config<T: Real>(sc: &Scenario) -> MonitorConfig<T> {
-    let m = &sc.monitor;
-    MonitorConfig {
-        coast_ticks: m.coast_ticks,
-        recovery_ticks: m.recovery_ticks,
-        length_jump_m: T::from_f64(m.length_jump_m),
-        alpha_jump_rad: T::from_f64(m.alpha_jump_rad),
-        stuck_ticks: m.stuck_ticks,
-        stuck_motion_rad: T::from_f64(m.stuck_motion_rad),
-        max_alpha_rate_radps: T::from_f64(m.max_alpha_rate_radps),
-        min_orbit_rate_radps: T::from_f64(m.min_orbit_rate_radps),
-        max_orbit_rate_radps: T::from_f64(m.max_orbit_rate_radps),
-    }
-}
-
-fn mass_model<T: Real>(sc: &Scenario) -> MassModel<T> {
-    MassModel {
-        main_initial_kg: T::from_f64(sc.masses.main_initial_kg),
-        sub_kg: T::from_f64(sc.masses.sub_kg),
-        tether_density_kg_per_m: T::from_f64(sc.tether.density_kg_per_m),
-    }
+    ticks(
+        "stage2.start_time_s",
+        sc.stage2.start_time_s,
+        sc.controller.period_s,
+    )?;
+    Ok(sc.controller_config())
 }
 
 /// The rigid plant's equations a scenario describes.
 pub fn plant(sc: &Scenario) -> RigidModel {
     RigidModel {
         orbit: Orbit::elliptic(sc.orbit.semi_major_axis_m, sc.orbit.eccentricity),
-        masses: mass_model(sc),
+        masses: sc.mass_model(),
     }
 }
 
@@ -241,7 +179,7 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
     let progress_every = ticks("progress", 60.0, period).unwrap_or(60).max(1);
 
     let mut history = History {
-        samples: Vec::with_capacity((total / every) as usize + 2),
+        samples: Vec::new(), // grown as written: never sized from the asked duration
         probes: Vec::with_capacity(probes.len()),
         ..History::default()
     };

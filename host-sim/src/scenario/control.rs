@@ -1,9 +1,10 @@
 //! `[controller]`, `[stage1]`, `[stage2]`: the control law's gains and period, and the two
-//! stages' reference schedules (Eqs. 27–35 of the paper).
+//! stages' reference schedules (Eqs. 27–35 of the paper). Most of their rules are the
+//! controller's own (`Config::validate`, named by scenario key in `core_rules.rs`); the ones
+//! here are the scenario's.
 
 use serde::{Deserialize, Serialize};
 
-use super::envelope::EnvelopeSection;
 use super::rules::{is_positive, num, Validator};
 
 /// `[controller]`
@@ -25,16 +26,6 @@ fn one_m() -> f64 {
     1.0
 }
 
-impl ControllerSection {
-    /// Period, gains and capture distance above 0.
-    pub(super) fn check(&self, v: &mut Validator) {
-        v.positive("controller.period_s", self.period_s);
-        v.positive("controller.k1_per_s", self.k1_per_s);
-        v.positive("controller.k2_per_s2", self.k2_per_s2);
-        v.positive("controller.keep_capture_m", self.keep_capture_m);
-    }
-}
-
 /// `[stage1]`: Eq. 34.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -52,29 +43,11 @@ pub struct Stage1Section {
 }
 
 impl Stage1Section {
-    /// c ≥ 0, α_r on the deployment side, the band below the keep length, k ≥ 0.
+    /// A band that starts above 0 and a slope k ≥ 0 (c ≥ 0, the deployment-side angle, the
+    /// band below the keep length and the keep inside the envelope are the controller's).
     pub(super) fn check(&self, v: &mut Validator) {
         let s1 = self;
-        v.non_negative("stage1.decay_rate_per_s", s1.decay_rate_per_s);
-        v.angle_in_open_range(
-            "stage1.deploy_angle_rad",
-            s1.deploy_angle_rad,
-            (-std::f64::consts::FRAC_PI_2, 0.0),
-            "(−π/2, 0) (the deployment side, Eq. 33)",
-        );
-        let band_ok = v.positive("stage1.band_start_m", s1.band_start_m);
-        let keep_ok = v.positive("stage1.keep_length_m", s1.keep_length_m);
-        if band_ok && keep_ok {
-            v.check(
-                s1.band_start_m < s1.keep_length_m,
-                "stage1.band_start_m",
-                num(s1.band_start_m),
-                &format!(
-                    "must be below stage1.keep_length_m = {}",
-                    num(s1.keep_length_m)
-                ),
-            );
-        }
+        v.positive("stage1.band_start_m", s1.band_start_m);
         v.non_negative("stage1.keep_slope_rad_per_m", s1.keep_slope_rad_per_m);
     }
 }
@@ -100,35 +73,16 @@ pub struct Stage2Section {
 }
 
 impl Stage2Section {
-    /// A start on a control tick, c ≥ 0, α_r on the retrieval side, a slew, the band above
-    /// the keep length, which is below stage 1's (stage 2 retrieves), k ≥ 0.
+    /// A start on a control tick, a band that starts above 0, a keep length below stage 1's
+    /// (stage 2 retrieves), k ≥ 0 (c ≥ 0, the retrieval-side angle, the slew rate, the band
+    /// above the keep length and the keep inside the envelope are the controller's).
     pub(super) fn check(&self, stage1: &Stage1Section, period_s: f64, v: &mut Validator) {
         let s2 = self;
         if v.non_negative("stage2.start_time_s", s2.start_time_s) {
             v.whole_multiple_of_period("stage2.start_time_s", s2.start_time_s, period_s, true);
         }
-        v.non_negative("stage2.decay_rate_per_s", s2.decay_rate_per_s);
-        v.angle_in_open_range(
-            "stage2.retrieve_angle_rad",
-            s2.retrieve_angle_rad,
-            (0.0, std::f64::consts::FRAC_PI_2),
-            "(0, π/2) (the retrieval side, Eq. 33)",
-        );
-        v.positive("stage2.slew_rate_radps", s2.slew_rate_radps);
-        let band_ok = v.positive("stage2.band_start_m", s2.band_start_m);
-        let keep_ok = v.positive("stage2.keep_length_m", s2.keep_length_m);
-        if band_ok && keep_ok {
-            v.check(
-                s2.keep_length_m < s2.band_start_m,
-                "stage2.band_start_m",
-                num(s2.band_start_m),
-                &format!(
-                    "must be above stage2.keep_length_m = {}",
-                    num(s2.keep_length_m)
-                ),
-            );
-        }
-        if keep_ok && is_positive(stage1.keep_length_m) {
+        v.positive("stage2.band_start_m", s2.band_start_m);
+        if is_positive(s2.keep_length_m) && is_positive(stage1.keep_length_m) {
             v.check(
                 s2.keep_length_m < stage1.keep_length_m,
                 "stage2.keep_length_m",
@@ -140,35 +94,5 @@ impl Stage2Section {
             );
         }
         v.non_negative("stage2.keep_slope_rad_per_m", s2.keep_slope_rad_per_m);
-    }
-}
-
-/// Both keep lengths strictly inside the envelope's length range.
-pub(super) fn check_keeps_within(
-    stage1: &Stage1Section,
-    stage2: &Stage2Section,
-    env: &EnvelopeSection,
-    v: &mut Validator,
-) {
-    if !env.lengths_valid() {
-        return; // reported on [envelope]
-    }
-    for (field, keep) in [
-        ("stage1.keep_length_m", stage1.keep_length_m),
-        ("stage2.keep_length_m", stage2.keep_length_m),
-    ] {
-        if is_positive(keep) {
-            v.check(
-                keep > env.min_length_m && keep < env.max_length_m,
-                field,
-                num(keep),
-                &format!(
-                    "must be inside the envelope (envelope.min_length_m = {}, \
-                     envelope.max_length_m = {})",
-                    num(env.min_length_m),
-                    num(env.max_length_m)
-                ),
-            );
-        }
     }
 }

@@ -1,8 +1,13 @@
-//! The scenario turned into the parameter types of the models it configures. The models (the
-//! fault injector, the reel drive, the fault summary) never read the schema: each takes its own
-//! parameters, and the conversions from the sections live here.
+//! The scenario turned into the parameter types of the models it configures: the flight
+//! controller's `Config`, the plant's mass model, the fault injector, the reel drive and the
+//! fault summary. None of them reads the schema: each takes its own parameters, and the
+//! conversions from the sections live here.
 
-use tss_reel::controller::Envelope;
+use tss_reel::controller::{Config, Envelope, MonitorConfig, Stage1Config, Stage2Config};
+use tss_reel::law::Gains;
+use tss_reel::mass::MassModel;
+use tss_reel::orbit::Orbit;
+use tss_reel::schedule::BandSchedule;
 use tss_reel::Real;
 
 use crate::elastic::environment::Environment;
@@ -13,12 +18,88 @@ use crate::faults::{
     Corruption, FaultSetup, Glitch, InjectionPlan, SensedQuantity, SensorErrors, Window,
 };
 use crate::reel::{Reel, ReelDrive};
-use tss_reel::orbit::Orbit;
 
 use super::{
-    EnvelopeSection, ReelModelName, ReelSection, Scenario, SensedDirection, SensorName,
-    SensorSection, WindowSection,
+    EnvelopeSection, MonitorSection, ReelModelName, ReelSection, Scenario, SensedDirection,
+    SensorName, SensorSection, WindowSection,
 };
+
+impl Scenario {
+    /// The flight controller's configuration, in its scalar type `T` (f32 on the target): the
+    /// numbers `Config::validate` judges. The stage-2 start is the nearest control tick.
+    pub fn controller_config<T: Real>(&self) -> Config<T> {
+        let f = T::from_f64;
+        let sc = self;
+        let period = sc.controller.period_s;
+        let stage2_tick = (sc.stage2.start_time_s / period)
+            .round()
+            .clamp(0.0, f64::from(u32::MAX)) as u32;
+        Config {
+            period_s: f(period),
+            orbit: Orbit::elliptic(f(sc.orbit.semi_major_axis_m), f(sc.orbit.eccentricity)),
+            masses: sc.mass_model(),
+            gains: Gains {
+                k1_per_s: f(sc.controller.k1_per_s),
+                k2_per_s2: f(sc.controller.k2_per_s2),
+            },
+            initial_rate_mps: f(sc.initial.length_rate_mps),
+            stage1: Stage1Config {
+                schedule: BandSchedule {
+                    low_length_m: f(sc.stage1.band_start_m),
+                    low_angle_rad: f(sc.stage1.deploy_angle_rad),
+                    low_slope_rad_per_m: T::ZERO,
+                    high_length_m: f(sc.stage1.keep_length_m),
+                    high_angle_rad: T::ZERO,
+                    high_slope_rad_per_m: f(sc.stage1.keep_slope_rad_per_m),
+                },
+                decay_rate_per_s: f(sc.stage1.decay_rate_per_s),
+            },
+            stage2: Stage2Config {
+                schedule: BandSchedule {
+                    low_length_m: f(sc.stage2.keep_length_m),
+                    low_angle_rad: T::ZERO,
+                    low_slope_rad_per_m: f(sc.stage2.keep_slope_rad_per_m),
+                    high_length_m: f(sc.stage2.band_start_m),
+                    high_angle_rad: f(sc.stage2.retrieve_angle_rad),
+                    high_slope_rad_per_m: T::ZERO,
+                },
+                slew_rate_radps: f(sc.stage2.slew_rate_radps),
+                decay_rate_per_s: f(sc.stage2.decay_rate_per_s),
+                start_tick: Some(stage2_tick),
+            },
+            keep_capture_m: f(sc.controller.keep_capture_m),
+            envelope: sc.envelope.to_envelope(),
+            monitor: sc.monitor.to_monitor_config(),
+        }
+    }
+
+    /// The masses of `[masses]` and `[tether]`, in scalar type `T`.
+    pub fn mass_model<T: Real>(&self) -> MassModel<T> {
+        MassModel {
+            main_initial_kg: T::from_f64(self.masses.main_initial_kg),
+            sub_kg: T::from_f64(self.masses.sub_kg),
+            tether_density_kg_per_m: T::from_f64(self.tether.density_kg_per_m),
+        }
+    }
+}
+
+impl MonitorSection {
+    /// The controller's sensor-monitor thresholds, in its scalar type `T`.
+    pub fn to_monitor_config<T: Real>(&self) -> MonitorConfig<T> {
+        let m = self;
+        MonitorConfig {
+            coast_ticks: m.coast_ticks,
+            recovery_ticks: m.recovery_ticks,
+            length_jump_m: T::from_f64(m.length_jump_m),
+            alpha_jump_rad: T::from_f64(m.alpha_jump_rad),
+            stuck_ticks: m.stuck_ticks,
+            stuck_motion_rad: T::from_f64(m.stuck_motion_rad),
+            max_alpha_rate_radps: T::from_f64(m.max_alpha_rate_radps),
+            min_orbit_rate_radps: T::from_f64(m.min_orbit_rate_radps),
+            max_orbit_rate_radps: T::from_f64(m.max_orbit_rate_radps),
+        }
+    }
+}
 
 impl From<&SensorSection> for SensorErrors {
     fn from(s: &SensorSection) -> Self {
@@ -26,8 +107,11 @@ impl From<&SensorSection> for SensorErrors {
             noise_std: s.noise_std,
             bias: s.bias,
             quantum: s.quantum,
-            stuck_from_s: s.stuck_from_s,
-            stuck_until_s: s.stuck_until_s,
+            // `stuck_from_s = inf` (the default) is never.
+            stuck: (s.stuck_from_s != f64::INFINITY).then_some(Window {
+                from_s: s.stuck_from_s,
+                until_s: s.stuck_until_s,
+            }),
         }
     }
 }

@@ -27,11 +27,11 @@ pub struct InitialSection {
 }
 
 impl InitialSection {
-    /// Every value finite, l(0) > 0, |β(0)| < π/2.
+    /// Every value finite, l(0) > 0, |β(0)| < π/2 (l̇0 is the controller's: finite, within the
+    /// envelope's rate).
     pub(super) fn check(&self, v: &mut Validator) {
         let i = self;
         v.positive("initial.length_m", i.length_m);
-        v.finite("initial.length_rate_mps", i.length_rate_mps);
         v.finite("initial.delta_rad", i.delta_rad);
         v.finite("initial.delta_rate_radps", i.delta_rate_radps);
         if v.finite("initial.beta_rad", i.beta_rad) {
@@ -45,20 +45,9 @@ impl InitialSection {
         v.finite("initial.beta_rate_radps", i.beta_rate_radps);
     }
 
-    /// The initial length and rate inside the envelope (checked after `[envelope]`'s rules).
+    /// The initial length inside the envelope (when the envelope itself is valid).
     pub(super) fn check_within(&self, env: &EnvelopeSection, v: &mut Validator) {
         let i = self;
-        if env.rate_valid() && i.length_rate_mps.is_finite() {
-            v.check(
-                i.length_rate_mps.abs() <= env.max_rate_mps,
-                "initial.length_rate_mps",
-                num(i.length_rate_mps),
-                &format!(
-                    "must be within ±envelope.max_rate_mps = {}",
-                    num(env.max_rate_mps)
-                ),
-            );
-        }
         if env.lengths_valid() && i.length_m.is_finite() && i.length_m > 0.0 {
             v.check(
                 (env.min_length_m..=env.max_length_m).contains(&i.length_m),

@@ -180,7 +180,7 @@ fn check_array(
 
 /// Parses the value of a `--set`: a TOML scalar (integer, float, bool, quoted string), or else the
 /// raw text as a string.
-fn parse_override_value(raw: &str) -> toml::Value {
+pub(super) fn parse_override_value(raw: &str) -> toml::Value {
     let raw = raw.trim();
     if let Ok(mut t) = toml::from_str::<toml::Table>(&format!("v = {raw}")) {
         if t.len() == 1 {

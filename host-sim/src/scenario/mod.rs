@@ -8,6 +8,9 @@
 //!   `[tether]`), `initial.rs`, `control.rs` (`[controller]`, `[stage1]`, `[stage2]`),
 //!   `envelope.rs`, `monitor.rs`, `simulation.rs`, `sensors.rs` (`[sensors]`, `[faults]`),
 //!   `reel.rs`, `link.rs`, `montecarlo.rs`, `plant.rs` (`[plant]`), `environment.rs`;
+//! - `core_rules.rs`: the flight controller's own rules, not repeated here: the f32 controller
+//!   is built from the scenario and the parameter path of what it rejects is named by scenario
+//!   key (this also catches values beyond f32's range);
 //! - `rules.rs`: the `Validator` the rules are written with (each failed rule a [`Problem`]);
 //! - `schema.rs`: every key with its type, traced from the structs (no hand-written list;
 //!   [`schema()`]);
@@ -15,7 +18,9 @@
 //!   ([`Scenario::load`]);
 //! - `convert.rs`: the scenario turned into the parameter types of the models it configures
 //!   (the physics never reads the schema);
-//! - `error.rs`: errors that name the file, the field and the value ([`ScenarioError`]).
+//! - `error.rs`: errors that name the file, the field and the value ([`ScenarioError`]);
+//! - [`keys`]: `tss-sim scenario keys`, every key with its unit, default and rules, read from
+//!   the schema and from validation itself.
 //!
 //! # Adding a section, say `[thermal]`
 //! 1. A file `thermal.rs` with `pub struct ThermalSection` (`#[derive(Clone, Debug,
@@ -26,16 +31,21 @@
 //!    `pub thermal: ThermalSection` in [`Scenario`], and a line in
 //!    [`Scenario::problems`] calling its `check`.
 //! 3. If a model takes it, a conversion in `convert.rs` into that model's own parameter type.
+//!    If it configures the flight controller, its rules are `Config::validate`'s: map the
+//!    controller's parameter path to the key in `core_rules.rs` instead of repeating them.
+//! 4. A count or size gets a documented bound (a `MAX_…` constant) checked in its `check`.
 //!
-//! The schema, `--set`, Monte Carlo dispersions and the resolved `scenario.toml` a run writes
-//! follow from the struct by themselves.
+//! The schema, `--set`, Monte Carlo dispersions, `tss-sim scenario keys` and the resolved
+//! `scenario.toml` a run writes follow from the struct by themselves.
 
 mod control;
 mod convert;
+mod core_rules;
 mod envelope;
 mod environment;
 mod error;
 mod initial;
+pub mod keys;
 mod link;
 mod load;
 mod monitor;
@@ -70,9 +80,11 @@ pub use reel::{ReelModelName, ReelSection};
 pub use schema::{schema, LeafKind, Schema};
 pub use sensors::{
     CorruptSection, FaultsSection, GlitchSection, SensorName, SensorSection, SensorsSection,
-    WindowSection,
+    WindowSection, MAX_FAULT_ENTRIES,
 };
-pub use simulation::{SimulationSection, MAX_TICKS};
+pub use simulation::{
+    SimulationSection, MAX_HISTORY_ROWS, MAX_PLANT_STEPS, MAX_SUBSTEPS, MAX_TICKS,
+};
 pub use system::{MassesSection, OrbitSection, TetherSection, EARTH_EQUATORIAL_RADIUS_M};
 
 use rules::Validator;
@@ -137,21 +149,17 @@ pub struct Scenario {
 
 impl Scenario {
     /// Checks that the scenario makes physical sense; returns every failed rule (empty =
-    /// valid), section by section, in the order of the file's fields.
+    /// valid): the scenario's own rules section by section, then the first rule of the flight
+    /// controller's configuration (built in f32, as flown) that fails.
     pub fn problems(&self) -> Vec<Problem> {
         let mut v = Validator::default();
         let s = self;
         s.check_name(&mut v);
         s.orbit.check(&mut v);
-        s.masses.check(&mut v);
         s.initial.check(&mut v);
-        s.controller.check(&mut v);
-        s.envelope.check(&mut v);
         s.initial.check_within(&s.envelope, &mut v);
         s.stage1.check(&mut v);
         s.stage2.check(&s.stage1, s.controller.period_s, &mut v);
-        control::check_keeps_within(&s.stage1, &s.stage2, &s.envelope, &mut v);
-        s.tether.check(&s.masses, &s.envelope, &mut v);
         s.simulation.check(s.controller.period_s, &mut v);
         s.montecarlo.check(s, &mut v);
         s.sensors.check(&mut v);
@@ -159,9 +167,12 @@ impl Scenario {
         s.reel.check(&mut v);
         s.monitor.check(&mut v);
         s.link.check(&mut v);
+        s.tether.check(&mut v);
         s.plant.check(s.controller.period_s, &mut v);
         s.environment.check(&mut v);
         s.check_elastic_only(&mut v);
+        // The flight controller's own rules, last (it reports the first it finds).
+        core_rules::check(s, &mut v);
         v.problems
     }
 

@@ -1,8 +1,10 @@
-//! `[monitor]`: the thresholds of the controller's sensor monitor.
+//! `[monitor]`: the thresholds of the controller's sensor monitor. Their rules are the
+//! controller's (`MonitorConfig::validate`, named by scenario key in `core_rules.rs`).
 
 use serde::{Deserialize, Serialize};
 
-use super::rules::{num, Validator};
+use super::rules::Validator;
+use super::simulation::MAX_TICKS;
 
 /// `[monitor]`: the controller's sensor checks and fault timing (`tss_reel`'s `MonitorConfig`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -46,30 +48,19 @@ impl Default for MonitorSection {
 }
 
 impl MonitorSection {
-    /// The same rules as `MonitorConfig::validate`, named by scenario key.
+    /// Tick counts within the longest run, [`MAX_TICKS`] (their other rules, ≥ 1 and the
+    /// thresholds, are the controller's: `MonitorConfig::validate`).
     pub(super) fn check(&self, v: &mut Validator) {
-        let m = self;
         for (field, ticks) in [
-            ("monitor.coast_ticks", m.coast_ticks),
-            ("monitor.recovery_ticks", m.recovery_ticks),
-            ("monitor.stuck_ticks", m.stuck_ticks),
+            ("monitor.coast_ticks", self.coast_ticks),
+            ("monitor.recovery_ticks", self.recovery_ticks),
+            ("monitor.stuck_ticks", self.stuck_ticks),
         ] {
-            v.check(ticks >= 1, field, ticks.to_string(), "must be at least 1");
-        }
-        v.positive("monitor.length_jump_m", m.length_jump_m);
-        v.positive("monitor.alpha_jump_rad", m.alpha_jump_rad);
-        v.positive("monitor.stuck_motion_rad", m.stuck_motion_rad);
-        v.positive("monitor.max_alpha_rate_radps", m.max_alpha_rate_radps);
-        let min_ok = v.positive("monitor.min_orbit_rate_radps", m.min_orbit_rate_radps);
-        if v.positive("monitor.max_orbit_rate_radps", m.max_orbit_rate_radps) && min_ok {
             v.check(
-                m.max_orbit_rate_radps > m.min_orbit_rate_radps,
-                "monitor.max_orbit_rate_radps",
-                num(m.max_orbit_rate_radps),
-                &format!(
-                    "must be above monitor.min_orbit_rate_radps = {}",
-                    num(m.min_orbit_rate_radps)
-                ),
+                ticks <= MAX_TICKS,
+                field,
+                ticks.to_string(),
+                &format!("must be at most {MAX_TICKS} (the longest run, in ticks)"),
             );
         }
     }

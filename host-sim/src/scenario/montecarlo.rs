@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::rules::{num, Validator};
 use super::schema::{schema, LeafKind};
-use super::{Problem, Scenario};
+use super::Scenario;
 
 /// `[montecarlo]`: what a campaign on this scenario disperses and what every run must achieve.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -169,144 +169,168 @@ pub(crate) fn nominal_in(table: &toml::Table, field: &str) -> Option<f64> {
 }
 
 impl MonteCarloSection {
-    /// Dispersed fields that exist, complete distributions, sane criteria (`sc` is the whole
-    /// scenario: the nominal values a dispersion is centred on).
+    /// At most one dispersion per number field, each of a field that exists and is dispersed
+    /// once, with a complete distribution; sane criteria (`sc` is the whole scenario: the
+    /// nominal values a dispersion is centred on).
     pub(super) fn check(&self, sc: &Scenario, v: &mut Validator) {
-        let mc = self;
-        let mut bad = |field: String, value: String, message: String| {
-            v.problems.push(Problem {
-                field,
-                value,
-                message,
-                from_override: false,
-            });
-        };
-        if !mc.dispersion.is_empty() {
-            let fields = dispersible_fields();
+        let fields = dispersible_fields();
+        let count_ok = v.check(
+            self.dispersion.len() <= fields.len(),
+            "montecarlo.dispersion",
+            format!("[{} entries]", self.dispersion.len()),
+            &format!(
+                "has more entries than the scenario's {} number fields (each is dispersed at \
+                 most once)",
+                fields.len()
+            ),
+        );
+        if count_ok && !self.dispersion.is_empty() {
             let table = toml::Table::try_from(sc).ok();
             let mut seen: Vec<&str> = Vec::new();
-            for (i, d) in mc.dispersion.iter().enumerate() {
+            for (i, d) in self.dispersion.iter().enumerate() {
                 let at = format!("montecarlo.dispersion[{i}]");
+                let field = format!("{at}.field");
                 if !fields.contains(&d.field.as_str()) {
-                    let section = d.field.rsplit_once('.').map_or("", |(p, _)| p);
-                    let near: Vec<&str> = fields
-                        .iter()
-                        .copied()
-                        .filter(|f| f.rsplit_once('.').map_or("", |(p, _)| p) == section)
-                        .collect();
-                    let hint = if near.is_empty() {
-                        "e.g. initial.delta_rad, masses.sub_kg, tether.density_kg_per_m, \
-                     sensors.alpha.noise_std, reel.lag_s"
-                            .to_string()
-                    } else {
-                        near.join(", ")
-                    };
-                    bad(
-                        format!("{at}.field"),
+                    v.check(
+                        false,
+                        &field,
                         format!("{:?}", d.field),
-                        format!(
-                            "is not a number field of the scenario (the keys --set takes; {hint})"
+                        &format!(
+                            "is not a number field of the scenario (the keys --set takes; {})",
+                            fields_like(&fields, &d.field)
                         ),
                     );
                     continue;
                 }
-                if seen.contains(&d.field.as_str()) {
-                    bad(
-                        format!("{at}.field"),
-                        format!("{:?}", d.field),
-                        "is dispersed twice".to_string(),
-                    );
-                }
+                v.check(
+                    !seen.contains(&d.field.as_str()),
+                    &field,
+                    format!("{:?}", d.field),
+                    "is dispersed twice",
+                );
                 seen.push(&d.field);
                 let nominal = table.as_ref().and_then(|t| nominal_in(t, &d.field));
-                let params = [
-                    ("mean", d.mean),
-                    ("std", d.std),
-                    ("min", d.min),
-                    ("max", d.max),
-                ];
-                for (name, value) in params {
-                    if let Some(x) = value {
-                        if !x.is_finite() {
-                            bad(
-                                format!("{at}.{name}"),
-                                num(x),
-                                "must be a finite number".to_string(),
-                            );
-                        }
-                    }
-                }
-                let (wanted, unused): (&[&str], &[&str]) = match d.distribution {
-                    Distribution::Normal => (&["std"], &["min", "max"]),
-                    Distribution::Uniform => (&["min", "max"], &["mean", "std"]),
-                };
-                let get = |name: &str| params.iter().find(|p| p.0 == name).and_then(|p| p.1);
-                for name in wanted {
-                    if get(name).is_none() {
-                        bad(
-                            format!("{at}.{name}"),
-                            "(missing)".to_string(),
-                            format!(
-                                "is required by distribution = \"{}\"",
-                                d.distribution.as_str()
-                            ),
-                        );
-                    }
-                }
-                for name in unused {
-                    if let Some(x) = get(name) {
-                        bad(
-                            format!("{at}.{name}"),
-                            num(x),
-                            format!(
-                                "is not used by distribution = \"{}\" (it takes {})",
-                                d.distribution.as_str(),
-                                wanted.join(" and ")
-                            ),
-                        );
-                    }
-                }
-                if let Some(s) = d.std {
-                    if s < 0.0 {
-                        bad(format!("{at}.std"), num(s), "must not be negative".into());
-                    }
-                }
-                if let (Some(lo), Some(hi)) = (d.min, d.max) {
-                    if lo > hi {
-                        bad(
-                            format!("{at}.max"),
-                            num(hi),
-                            format!("must not be below {at}.min = {}", num(lo)),
-                        );
-                    }
-                }
-                let needs_nominal =
-                    d.relative || (d.distribution == Distribution::Normal && d.mean.is_none());
-                match nominal {
-                    Some(x) if needs_nominal && !x.is_finite() => bad(
-                        format!("{at}.field"),
-                        format!("{:?}", d.field),
-                        format!(
-                            "has the nominal value {}, which a {} dispersion cannot be centred on \
-                         (give a mean, or min and max)",
-                            num(x),
-                            if d.relative { "relative" } else { "normal" }
-                        ),
-                    ),
-                    Some(x) if d.relative && x == 0.0 => bad(
-                        format!("{at}.relative"),
-                        "true".to_string(),
-                        format!(
-                            "cannot scale {} = 0 (a relative dispersion multiplies the nominal \
-                         value; use an absolute one)",
-                            d.field
-                        ),
-                    ),
-                    _ => {}
-                }
+                d.check(&at, nominal, v);
             }
         }
-        let c = &mc.criteria;
+        self.criteria.check(v);
+    }
+}
+
+/// The dispersible fields in the section of `field`, or a few examples.
+fn fields_like(fields: &[&str], field: &str) -> String {
+    let section = |f: &str| f.rsplit_once('.').map_or("", |(p, _)| p).to_string();
+    let near: Vec<&str> = fields
+        .iter()
+        .copied()
+        .filter(|f| section(f) == section(field))
+        .collect();
+    if near.is_empty() {
+        "e.g. initial.delta_rad, masses.sub_kg, tether.density_kg_per_m, \
+         sensors.alpha.noise_std, reel.lag_s"
+            .to_string()
+    } else {
+        near.join(", ")
+    }
+}
+
+impl DispersionSection {
+    /// Finite parameters, those of its distribution and no others, std ≥ 0, min ≤ max, and a
+    /// nominal value it can be centred on or scale (`at`: `montecarlo.dispersion[i]`).
+    fn check(&self, at: &str, nominal: Option<f64>, v: &mut Validator) {
+        let d = self;
+        let params = [
+            ("mean", d.mean),
+            ("std", d.std),
+            ("min", d.min),
+            ("max", d.max),
+        ];
+        for (name, value) in params {
+            if let Some(x) = value {
+                v.finite(&format!("{at}.{name}"), x);
+            }
+        }
+        let (wanted, unused): (&[&str], &[&str]) = match d.distribution {
+            Distribution::Normal => (&["std"], &["min", "max"]),
+            Distribution::Uniform => (&["min", "max"], &["mean", "std"]),
+        };
+        let get = |name: &str| params.iter().find(|p| p.0 == name).and_then(|p| p.1);
+        let distribution = d.distribution.as_str();
+        for name in wanted {
+            v.check(
+                get(name).is_some(),
+                &format!("{at}.{name}"),
+                "(missing)".to_string(),
+                &format!("is required by distribution = \"{distribution}\""),
+            );
+        }
+        for name in unused {
+            if let Some(x) = get(name) {
+                v.check(
+                    false,
+                    &format!("{at}.{name}"),
+                    num(x),
+                    &format!(
+                        "is not used by distribution = \"{distribution}\" (it takes {})",
+                        wanted.join(" and ")
+                    ),
+                );
+            }
+        }
+        if let Some(s) = d.std {
+            v.check(
+                s.is_nan() || s >= 0.0, // NaN is reported as not finite
+                &format!("{at}.std"),
+                num(s),
+                "must not be negative",
+            );
+        }
+        if let (Some(lo), Some(hi)) = (d.min, d.max) {
+            v.check(
+                lo.is_nan() || hi.is_nan() || lo <= hi,
+                &format!("{at}.max"),
+                num(hi),
+                &format!("must not be below {at}.min = {}", num(lo)),
+            );
+        }
+        let needs_nominal =
+            d.relative || (d.distribution == Distribution::Normal && d.mean.is_none());
+        match nominal {
+            Some(x) if needs_nominal && !x.is_finite() => {
+                v.check(
+                    false,
+                    &format!("{at}.field"),
+                    format!("{:?}", d.field),
+                    &format!(
+                        "has the nominal value {}, which a {} dispersion cannot be centred on \
+                         (give a mean, or min and max)",
+                        num(x),
+                        if d.relative { "relative" } else { "normal" }
+                    ),
+                );
+            }
+            Some(x) if d.relative && x == 0.0 => {
+                v.check(
+                    false,
+                    &format!("{at}.relative"),
+                    "true".to_string(),
+                    &format!(
+                        "cannot scale {} = 0 (a relative dispersion multiplies the nominal \
+                         value; use an absolute one)",
+                        d.field
+                    ),
+                );
+            }
+            _ => {}
+        }
+    }
+}
+
+impl CriteriaSection {
+    /// Error bounds ≥ 0 (inf = not checked), a tension bound that is a number, a window that
+    /// starts at a finite time ≥ 0 and does not end before it starts.
+    fn check(&self, v: &mut Validator) {
+        let c = self;
         for (field, x) in [
             ("montecarlo.criteria.max_keep1_error_m", c.max_keep1_error_m),
             (
@@ -316,32 +340,31 @@ impl MonteCarloSection {
             ("montecarlo.criteria.max_overshoot_m", c.max_overshoot_m),
             ("montecarlo.criteria.max_final_error_m", c.max_final_error_m),
         ] {
-            if x.is_nan() || x < 0.0 {
-                bad(
-                    field.to_string(),
-                    num(x),
-                    "must not be negative (inf = not checked)".to_string(),
-                );
-            }
-        }
-        if c.min_tension_n.is_nan() || c.min_tension_n == f64::INFINITY {
-            bad(
-                "montecarlo.criteria.min_tension_n".to_string(),
-                num(c.min_tension_n),
-                "must be a number (-inf = not checked)".to_string(),
+            v.check(
+                x >= 0.0,
+                field,
+                num(x),
+                "must not be negative (inf = not checked)",
             );
         }
-        if !(c.keep1_from_s.is_finite() && c.keep1_from_s >= 0.0) {
-            bad(
-                "montecarlo.criteria.keep1_from_s".to_string(),
-                num(c.keep1_from_s),
-                "must be a finite time ≥ 0".to_string(),
-            );
-        } else if c.keep1_until_s.is_nan() || c.keep1_until_s < c.keep1_from_s {
-            bad(
-                "montecarlo.criteria.keep1_until_s".to_string(),
+        v.check(
+            !c.min_tension_n.is_nan() && c.min_tension_n != f64::INFINITY,
+            "montecarlo.criteria.min_tension_n",
+            num(c.min_tension_n),
+            "must be a number (-inf = not checked)",
+        );
+        let from_ok = v.check(
+            c.keep1_from_s.is_finite() && c.keep1_from_s >= 0.0,
+            "montecarlo.criteria.keep1_from_s",
+            num(c.keep1_from_s),
+            "must be a finite time ≥ 0",
+        );
+        if from_ok {
+            v.check(
+                c.keep1_until_s >= c.keep1_from_s,
+                "montecarlo.criteria.keep1_until_s",
                 num(c.keep1_until_s),
-                format!(
+                &format!(
                     "must not be before montecarlo.criteria.keep1_from_s = {}",
                     num(c.keep1_from_s)
                 ),

@@ -8,9 +8,15 @@ use super::Problem;
 /// (e.g. the output interval of the control period): 1e-9 of the ratio.
 const WHOLE_MULTIPLE_REL_TOL: f64 = 1e-9;
 
-/// `{}` of an f64 (shortest round-trip form; `40000` for 40000.0).
+/// An f64 as messages write it: the shortest form that reads back exactly, `40000` for
+/// 40000.0, in exponent form (`1e308`, `1e-50`) beyond 1e16 and below 1e-6 in magnitude.
 pub(super) fn num(x: f64) -> String {
-    format!("{x}")
+    let a = x.abs();
+    if a.is_finite() && a != 0.0 && !(1e-6..1e16).contains(&a) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
 }
 
 /// A finite number above 0: the rule a value passed, for the rules that compare against it.
@@ -79,22 +85,6 @@ impl Validator {
                 until_field,
                 num(until),
                 &format!("must be after {from_field} = {}", num(from)),
-            );
-        }
-    }
-    pub(super) fn angle_in_open_range(
-        &mut self,
-        field: &str,
-        x: f64,
-        (lo, hi): (f64, f64),
-        range: &str,
-    ) {
-        if self.finite(field, x) {
-            self.check(
-                x > lo && x < hi,
-                field,
-                num(x),
-                &format!("must be within {range}"),
             );
         }
     }

@@ -163,10 +163,28 @@ impl SensorsSection {
     }
 }
 
+/// The most entries of each fault list (`[[faults.dropout]]`, `[[faults.corrupt]]`,
+/// `[[faults.length_glitch]]`): every control tick looks at each entry, so a run's cost grows
+/// with their number.
+pub const MAX_FAULT_ENTRIES: usize = 1_000;
+
 impl FaultsSection {
-    /// Windows that start at a finite time ≥ 0 and end after they start; finite glitches.
+    /// At most [`MAX_FAULT_ENTRIES`] per list; windows that start at a finite time ≥ 0 and end
+    /// after they start; finite glitches. A list beyond the bound is reported as a whole.
     pub(super) fn check(&self, v: &mut Validator) {
-        for (i, w) in self.dropout.iter().enumerate() {
+        let mut within = |list: &str, len: usize| {
+            v.check(
+                len <= MAX_FAULT_ENTRIES,
+                &format!("faults.{list}"),
+                format!("[{len} entries]"),
+                &format!("has more entries than the simulator's {MAX_FAULT_ENTRIES}"),
+            )
+        };
+        let dropout_ok = within("dropout", self.dropout.len());
+        let corrupt_ok = within("corrupt", self.corrupt.len());
+        let glitch_ok = within("length_glitch", self.length_glitch.len());
+        let take = |ok: bool| if ok { usize::MAX } else { 0 };
+        for (i, w) in self.dropout.iter().take(take(dropout_ok)).enumerate() {
             let at = format!("faults.dropout[{i}]");
             v.window(
                 &format!("{at}.from_s"),
@@ -176,7 +194,7 @@ impl FaultsSection {
                 false,
             );
         }
-        for (i, c) in self.corrupt.iter().enumerate() {
+        for (i, c) in self.corrupt.iter().take(take(corrupt_ok)).enumerate() {
             let at = format!("faults.corrupt[{i}]");
             v.window(
                 &format!("{at}.from_s"),
@@ -186,7 +204,7 @@ impl FaultsSection {
                 false,
             );
         }
-        for (i, g) in self.length_glitch.iter().enumerate() {
+        for (i, g) in self.length_glitch.iter().take(take(glitch_ok)).enumerate() {
             v.non_negative(&format!("faults.length_glitch[{i}].at_s"), g.at_s);
             v.finite(&format!("faults.length_glitch[{i}].size_m"), g.size_m);
         }

@@ -1,9 +1,10 @@
 //! `[orbit]`, `[masses]`, `[tether]`: the physical system the controller flies (Eq. 5 of the
-//! paper), and the rules that keep it physical.
+//! paper). The masses' and the tether's rules (positive masses, ρ ≥ 0, a tether lighter than
+//! the main satellite) are the controller's (`core_rules.rs`); the orbit's perigee and the
+//! elastic plant's tether keys are the scenario's.
 
 use serde::{Deserialize, Serialize};
 
-use super::envelope::EnvelopeSection;
 use super::rules::{num, Validator};
 
 /// Equatorial radius of the Earth (WGS-84), m: the orbit's perigee must lie above it.
@@ -24,18 +25,10 @@ pub struct OrbitSection {
 }
 
 impl OrbitSection {
-    /// a > 0, e in [0, 1), θ(0) finite, and the perigee a(1 − e) above the Earth's surface.
+    /// θ(0) finite, and the perigee a(1 − e) above the Earth's surface (a > 0 and the range
+    /// of e are the controller's rules).
     pub(super) fn check(&self, v: &mut Validator) {
         let o = self;
-        v.positive("orbit.semi_major_axis_m", o.semi_major_axis_m);
-        if v.finite("orbit.eccentricity", o.eccentricity) {
-            v.check(
-                (0.0..1.0).contains(&o.eccentricity),
-                "orbit.eccentricity",
-                num(o.eccentricity),
-                "must be in [0, 1)",
-            );
-        }
         v.finite("orbit.initial_true_anomaly_rad", o.initial_true_anomaly_rad);
         if o.semi_major_axis_m.is_finite()
             && o.semi_major_axis_m > 0.0
@@ -65,14 +58,6 @@ pub struct MassesSection {
     pub main_initial_kg: f64,
     /// m2, sub-satellite, kg.
     pub sub_kg: f64,
-}
-
-impl MassesSection {
-    /// Both masses above 0.
-    pub(super) fn check(&self, v: &mut Validator) {
-        v.positive("masses.main_initial_kg", self.main_initial_kg);
-        v.positive("masses.sub_kg", self.sub_kg);
-    }
 }
 
 /// `[tether]`. The rigid plant uses ρ only; the elastic plant all of it (the defaults are the
@@ -137,9 +122,9 @@ impl Default for TetherSection {
 }
 
 impl TetherSection {
-    /// EA > 0, C, d, C_d ≥ 0, 0 < l_k ≤ L_s; ρ ≥ 0, and the tether never outweighs the main satellite, even paid out to the longest
-    /// length the envelope allows.
-    pub(super) fn check(&self, masses: &MassesSection, env: &EnvelopeSection, v: &mut Validator) {
+    /// The elastic plant's keys: EA > 0; C, d, C_d ≥ 0; 0 < l_k ≤ L_s. (ρ's rules are the
+    /// controller's mass model's, `core_rules`.)
+    pub(super) fn check(&self, v: &mut Validator) {
         v.positive("tether.axial_stiffness_n", self.axial_stiffness_n);
         v.non_negative("tether.damping_ns", self.damping_ns);
         v.non_negative("tether.diameter_m", self.diameter_m);
@@ -155,24 +140,6 @@ impl TetherSection {
                     num(self.segment_length_m)
                 ),
             );
-        }
-        if v.non_negative("tether.density_kg_per_m", self.density_kg_per_m) {
-            let longest_m = env.max_length_m;
-            let tether_kg = self.density_kg_per_m * longest_m;
-            if env.max_length_valid() && masses.main_initial_kg.is_finite() {
-                v.check(
-                    tether_kg < masses.main_initial_kg,
-                    "tether.density_kg_per_m",
-                    num(self.density_kg_per_m),
-                    &format!(
-                        "makes the tether at envelope.max_length_m = {} m weigh {} kg, not \
-                         below masses.main_initial_kg = {}",
-                        num(longest_m),
-                        num(tether_kg),
-                        num(masses.main_initial_kg)
-                    ),
-                );
-            }
         }
     }
 }

@@ -403,8 +403,8 @@ fn every_rule_names_file_field_and_value() {
         (&["orbit.semi_major_axis_m=-1"], "orbit.semi_major_axis_m", "-1", "must be above 0"),
         (&["orbit.semi_major_axis_m=6000000"], "orbit.semi_major_axis_m", "6000000", "inside the Earth"),
         (&["orbit.eccentricity=0.2"], "orbit.semi_major_axis_m", "7078000", "inside the Earth"),
-        (&["orbit.eccentricity=1"], "orbit.eccentricity", "1", "must be in [0, 1)"),
-        (&["orbit.eccentricity=-0.1"], "orbit.eccentricity", "-0.1", "must be in [0, 1)"),
+        (&["orbit.eccentricity=1"], "orbit.eccentricity", "1", "must be in [0, 0.75): beyond it no equilibrium"),
+        (&["orbit.eccentricity=-0.1"], "orbit.eccentricity", "-0.1", "must be in [0, 0.75)"),
         (&["orbit.initial_true_anomaly_rad=nan"], "orbit.initial_true_anomaly_rad", "NaN", "finite"),
         (&["masses.main_initial_kg=0"], "masses.main_initial_kg", "0", "must be above 0"),
         (&["masses.sub_kg=-5"], "masses.sub_kg", "-5", "must be above 0"),
@@ -464,7 +464,7 @@ fn every_rule_names_file_field_and_value() {
         (&["reel.max_accel_mps2=nan"], "reel.max_accel_mps2", "NaN", "must be above 0"),
         (&["monitor.coast_ticks=0"], "monitor.coast_ticks", "0", "must be at least 1"),
         (&["monitor.length_jump_m=0"], "monitor.length_jump_m", "0", "must be above 0"),
-        (&["monitor.max_orbit_rate_radps=-1"], "monitor.max_orbit_rate_radps", "-1", "must be above 0"),
+        (&["monitor.max_orbit_rate_radps=-1"], "monitor.max_orbit_rate_radps", "-1", "must be above monitor.min_orbit_rate_radps"),
         (&["monitor.max_orbit_rate_radps=1e-6"], "monitor.max_orbit_rate_radps", "0.000001", "must be above monitor.min_orbit_rate_radps = 0.00001"),
     ];
     for (sets, field, value, message) in cases {
@@ -485,13 +485,24 @@ fn every_rule_names_file_field_and_value() {
     }
 }
 
+/// The scenario's own rules all report at once; the controller's configuration adds the
+/// first of its rules that fails (it stops there), last.
 #[test]
 fn all_problems_are_reported_at_once() {
-    let e = load(&["masses.sub_kg=0", "controller.k1_per_s=0"]).unwrap_err();
+    let e = load(&[
+        "masses.sub_kg=0",
+        "controller.k1_per_s=0",
+        "initial.delta_rad=nan",
+        "simulation.substeps=0",
+    ])
+    .unwrap_err();
     match e {
         ScenarioError::Invalid { problems, .. } => {
             let fields: Vec<&str> = problems.iter().map(|p| p.field.as_str()).collect();
-            assert_eq!(fields, ["masses.sub_kg", "controller.k1_per_s"]);
+            assert_eq!(
+                fields,
+                ["initial.delta_rad", "simulation.substeps", "masses.sub_kg"]
+            );
         }
         other => panic!("{other}"),
     }
@@ -510,4 +521,190 @@ fn the_paper_scenario_is_valid_and_its_rules_hold_in_the_example_from_the_brief(
              (set by --set)"
         )
     );
+}
+
+/// The controller's rules are not repeated here: the scenario builds the f32 controller and
+/// names what it rejects by scenario key. e = 0.8 passed the scenario's old `[0, 1)` and then
+/// failed the run (exit 1, "controller configuration rejected").
+#[test]
+fn the_controllers_own_rules_are_named_by_scenario_key() {
+    for (sets, line) in [
+        (
+            &["orbit.eccentricity=0.8"][..],
+            "orbit.eccentricity = 0.8 must be in [0, 0.75): beyond it no equilibrium exists",
+        ),
+        (
+            &["controller.k2_per_s2=0"][..],
+            "controller.k2_per_s2 = 0 must be above 0",
+        ),
+        (
+            &["envelope.max_length_m=20000"][..],
+            "stage1.keep_length_m = 30000 must be inside the envelope",
+        ),
+        (
+            &["monitor.stuck_ticks=0"][..],
+            "monitor.stuck_ticks = 0 must be at least 1",
+        ),
+        (
+            &["initial.length_rate_mps=nan"][..],
+            "initial.length_rate_mps = NaN must be a finite number",
+        ),
+        (
+            &["stage2.keep_slope_rad_per_m=inf"][..],
+            "stage2.keep_slope_rad_per_m = inf must be a finite number",
+        ),
+    ] {
+        let e = err(sets);
+        assert!(e.contains(&format!("{FILE}: {line}")), "{sets:?}: {e}");
+    }
+}
+
+/// What the f32 controller will see is validated: a value beyond f32's range (finite in the
+/// file) is an error naming the field and the value, not an `inf` later in the run.
+#[test]
+fn values_that_overflow_the_controllers_f32_are_rejected() {
+    for (set, field, value) in [
+        (
+            "masses.main_initial_kg=1e308",
+            "masses.main_initial_kg",
+            "1e308",
+        ),
+        ("controller.k1_per_s=1e39", "controller.k1_per_s", "1e39"),
+        (
+            "envelope.max_rate_mps=-1e300",
+            "envelope.max_rate_mps",
+            "-1e300",
+        ),
+        ("stage1.band_start_m=4e38", "stage1.band_start_m", "4e38"),
+    ] {
+        let e = err(&[set]);
+        let head = format!("{FILE}: {field} = {value} overflows the controller's f32");
+        assert!(e.starts_with(&head), "{set}: {e}");
+    }
+    let e = err(&["controller.period_s=1e-50"]);
+    assert!(
+        e.contains("controller.period_s = 1e-50 must be above 0 (it is 0 in the controller's f32)"),
+        "{e}"
+    );
+}
+
+/// Every size has a bound, checked at load (before any work), naming the field and value.
+/// `simulation.duration_s = 4294967295` used to pass and abort the run on a 48 GB allocation.
+#[test]
+fn every_size_and_count_has_a_bound() {
+    let window = "{ from_s = 1, until_s = 2 }";
+    let many = |n: usize| vec![window; n].join(", ");
+    let dropouts = format!("faults.dropout=[{}]", many(MAX_FAULT_ENTRIES + 1));
+    let cases: Vec<(Vec<String>, &str, &str)> = vec![
+        (
+            vec!["simulation.duration_s=4294967295".into()],
+            "simulation.duration_s = 4294967295 is 4294967295 control periods, more than the simulator's 10000000",
+            "",
+        ),
+        (
+            vec!["simulation.substeps=1001".into()],
+            "simulation.substeps = 1001 must be at most 1000",
+            "",
+        ),
+        (
+            vec![
+                "simulation.duration_s=200000".into(),
+                "simulation.substeps=1000".into(),
+            ],
+            "simulation.substeps = 1000 makes 200000000 plant steps",
+            "more than the simulator's 100000000",
+        ),
+        (
+            vec![
+                "simulation.duration_s=2000000".into(),
+                "simulation.output_interval_s=1".into(),
+            ],
+            "simulation.output_interval_s = 1 makes 2000001 rows of history",
+            "more than the simulator's 1000000",
+        ),
+        (
+            vec![dropouts],
+            "faults.dropout = [1001 entries] has more entries than the simulator's 1000",
+            "",
+        ),
+        (
+            vec!["monitor.coast_ticks=10000001".into()],
+            "monitor.coast_ticks = 10000001 must be at most 10000000",
+            "",
+        ),
+    ];
+    for (sets, head, rest) in cases {
+        let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+        let e = err(&sets);
+        let line = e
+            .lines()
+            .find(|l| l.starts_with(&format!("{FILE}: {head}")))
+            .unwrap_or_else(|| panic!("no {head:?} in {e}"));
+        assert!(line.contains(rest), "{line}");
+        // A list beyond its bound is one problem, not one per entry.
+        assert!(e.lines().count() <= 2, "{e}");
+    }
+    // At the bounds, accepted.
+    load(&["simulation.substeps=1000"]).unwrap();
+    load(&[&format!("faults.dropout=[{}]", many(MAX_FAULT_ENTRIES))]).unwrap_or_else(|e| {
+        // Identical windows are valid; only the count is under test.
+        panic!("{e}")
+    });
+    load(&[
+        "simulation.duration_s=999990",
+        "simulation.output_interval_s=1",
+    ])
+    .unwrap();
+}
+
+#[test]
+fn a_campaign_disperses_each_field_at_most_once() {
+    let n = dispersible_fields().len() + 1;
+    let entry = "[[montecarlo.dispersion]]\nfield = \"masses.sub_kg\"\ndistribution = \"normal\"\nstd = 1.0\n";
+    let text = format!("{BASE}{}", entry.repeat(n));
+    let e = Scenario::from_toml_str(&text, FILE, &[])
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        e,
+        format!(
+            "{FILE}: montecarlo.dispersion = [{n} entries] has more entries than the scenario's {} number fields (each is dispersed at most once)",
+            n - 1
+        )
+    );
+}
+
+/// The models' parameter types mean what the sections' defaults mean: a perfect sensor, an
+/// ideal reel, nothing injected; a stuck window from its start to its end.
+#[test]
+fn conversions_keep_the_meaning_of_the_defaults() {
+    use crate::faults::{InjectionPlan, SensorErrors, Window};
+    use crate::reel::ReelDrive;
+    let s = load(&[]).unwrap();
+    assert!(InjectionPlan::from(&s).is_transparent());
+    assert!(ReelDrive::from(&s.reel).is_ideal());
+    assert_eq!(
+        SensorErrors::from(&SensorSection::default()),
+        SensorErrors::default()
+    );
+    let s = load(&[
+        "sensors.alpha.stuck_from_s=50",
+        "sensors.length.bias=0.5",
+        "reel.lag_s=2",
+    ])
+    .unwrap();
+    let plan = InjectionPlan::from(&s);
+    assert_eq!(
+        plan.alpha.stuck,
+        Some(Window {
+            from_s: 50.0,
+            until_s: f64::INFINITY
+        })
+    );
+    assert_eq!(plan.length.bias, 0.5);
+    assert!(!plan.is_transparent());
+    assert!(!ReelDrive::from(&s.reel).is_ideal());
+    let cfg = s.controller_config::<f32>();
+    assert_eq!(cfg.stage2.start_tick, Some(28_800));
+    assert_eq!(cfg.envelope.max_rate_mps, 10.0);
 }
