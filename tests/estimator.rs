@@ -1,5 +1,5 @@
 //! Proofs of the libration estimator (`src/estimator.rs`, issue 18): the filter on α samples
-//! alone, driven by the reel, against the simulator's rigid plant (`tss_sim::plant::Plant`,
+//! alone, driven by the reel, against the simulator's rigid plant (`tss_sim::plant::RigidModel`,
 //! Eq. 5) flying the paper's whole mission under the flight controller.
 //!
 //! The controller still flies on the true α̇ here (wiring the estimator into it is the next
@@ -16,7 +16,7 @@ use std::sync::OnceLock;
 use tss_reel::controller::{Controller, Input};
 use tss_reel::estimator::{Config, Drive, Estimate, Estimator, Measurement, Output, Prediction};
 use tss_reel::Real;
-use tss_sim::plant::{ix, Plant, State};
+use tss_sim::plant::{ix, RigidModel, State};
 use tss_sim::scenario::Scenario;
 use tss_sim::sim::{self, Stepper};
 
@@ -152,7 +152,7 @@ fn fly(duration_s: f64, process: Option<(&Config<f64>, u64)>) -> Vec<Tick> {
 fn fly_scenario(sc: &Scenario, duration_s: f64, process: Option<(&Config<f64>, u64)>) -> Vec<Tick> {
     let cfg = sim::controller_config::<f32>(sc).expect("paper config");
     let mut ctl = Controller::new(cfg).expect("valid controller");
-    let plant: Plant = sim::plant(sc);
+    let plant: RigidModel = sim::plant(sc);
     let mut x: State = sim::initial_state(sc, &cfg);
     let h = sc.controller.period_s;
     let total = (duration_s / h).round() as u32;
@@ -793,7 +793,7 @@ fn one_period_matches_the_plant() {
     // plant (Eq. 5b, the same model) integrated with 1 000 RK4 substeps, from states along the
     // mission: the release, early deployment, 9 km, the 30 km keep, retrieval.
     let sc = paper_scenario();
-    let plant: Plant = sim::plant(&sc);
+    let plant: RigidModel = sim::plant(&sc);
     let cases = [
         (1.0, 0.1, -0.61, 0.0),
         (20.0, 0.3, -1.2, -8e-4),
@@ -855,7 +855,7 @@ fn the_discretisation_error_against_the_period() {
     // deployment (l̇ = 1.5 m/s): the error grows as h³ (the midpoint rule for s and the
     // local-linearisation step are second order).
     let sc = paper_scenario();
-    let plant: Plant = sim::plant(&sc);
+    let plant: RigidModel = sim::plant(&sc);
     for (l, v, alpha, rate) in [(100.0, 2.0, -0.9, -6e-4), (9_000.0, 1.5, -0.78, 2e-5)] {
         let mut previous: Option<(f64, f64, f64)> = None;
         for h in [1.0, 2.0, 5.0, 10.0] {
@@ -1162,7 +1162,7 @@ fn the_law_flies_the_mission_on_the_estimate_with_a_taut_tether() {
     let fly_on = |estimated: bool| {
         let cfg = sim::controller_config::<f32>(&sc).expect("config");
         let mut ctl = Controller::new(cfg).expect("controller");
-        let plant: Plant = sim::plant(&sc);
+        let plant: RigidModel = sim::plant(&sc);
         let mut x: State = sim::initial_state(&sc, &cfg);
         let mut est = Estimator::<f32>::new(Config::paper()).expect("estimator");
         let mut rng = Normal::new(29);

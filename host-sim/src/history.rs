@@ -81,6 +81,11 @@ pub struct History {
     /// Faults, health, tension and envelope over every control tick of the run (see
     /// `faults::FaultSummary`; all zero for a history not made by `sim::run`).
     pub faults: crate::faults::FaultSummary,
+    /// The elastic plant's extra quantities, one per sample (empty for the rigid plant).
+    pub elastic: Vec<crate::plant::ElasticObservation>,
+    /// The tether's shape every `plant.shape_interval_s` and at the end (elastic plant):
+    /// (t_s, node positions relative to the main satellite in the orbit frame e_r, e_θ, e_h, m).
+    pub shapes: Vec<(f64, Vec<[f64; 3]>)>,
 }
 
 /// The controller's flag bits (`tss_reel::controller::Flags`, the `flags` column of

@@ -304,6 +304,60 @@ pub fn write_history_csv<W: Write>(mut w: W, samples: &[Sample]) -> io::Result<(
     w.flush()
 }
 
+/// The columns the elastic plant's `history.csv` adds after [`HISTORY_EXTRA_COLUMNS`]
+/// (`length_m` is then the paid-out length at the reel, `tension_n` the tension there).
+pub const HISTORY_ELASTIC_COLUMNS: [&str; 6] = [
+    "range_m",
+    "tension_tip_n",
+    "bowing_m",
+    "alpha_sensed_rad",
+    "reel_rate_mps",
+    "beads",
+];
+
+/// Writes the elastic plant's history: the columns of [`write_history_csv`], then
+/// [`HISTORY_ELASTIC_COLUMNS`] from `elastic` (one per sample).
+pub fn write_elastic_history_csv<W: Write>(
+    mut w: W,
+    samples: &[Sample],
+    elastic: &[crate::plant::ElasticObservation],
+) -> io::Result<()> {
+    writeln!(
+        w,
+        "{},{}",
+        history_header(),
+        HISTORY_ELASTIC_COLUMNS.join(",")
+    )?;
+    for (s, e) in samples.iter().zip(elastic) {
+        writeln!(
+            w,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            s.t_s,
+            s.length_m,
+            s.length_rate_mps,
+            s.alpha_rad,
+            s.alpha_ref_rad,
+            s.delta_rad,
+            s.delta_rate_radps,
+            s.beta_rad,
+            s.tension_n,
+            s.phase.as_str(),
+            s.alpha_rate_radps,
+            s.length_accel_mps2,
+            s.law_rate_mps,
+            s.blend_weight,
+            s.flags,
+            e.range_m,
+            e.tension_tip_n,
+            e.bowing_m,
+            e.alpha_sensed_rad,
+            e.reel_rate_mps,
+            e.beads,
+        )?;
+    }
+    w.flush()
+}
+
 /// Why a `history.csv` could not be read back.
 #[derive(Debug, thiserror::Error)]
 pub enum HistoryCsvError {

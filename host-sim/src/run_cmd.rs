@@ -234,7 +234,11 @@ where
     let started = Instant::now();
     let mut files = Vec::new();
     files.push(out.write("history.csv", |w| {
-        output::write_history_csv(w, &history.samples)
+        if history.elastic.is_empty() {
+            output::write_history_csv(w, &history.samples)
+        } else {
+            output::write_elastic_history_csv(w, &history.samples, &history.elastic)
+        }
     })?);
     let table = Table1Comparison::new(&history.probes);
     files.push(out.write("table1.csv", |w| table.write_csv(w))?);

@@ -10,14 +10,18 @@ use tss_reel::orbit::Orbit;
 use tss_reel::schedule::BandSchedule;
 use tss_reel::Real;
 
+use crate::elastic::environment::Environment;
+use crate::elastic::reel_drum::DrumParams;
+use crate::elastic::tether::TetherParams;
+use crate::elastic::{BodyParams, ElasticParams, OrbitParams, ReelModel, ReelParams, Sensing};
 use crate::faults::{
     Corruption, FaultSetup, Glitch, InjectionPlan, SensedQuantity, SensorErrors, Window,
 };
-use crate::reel::ReelDrive;
+use crate::reel::{Reel, ReelDrive};
 
 use super::{
-    EnvelopeSection, MonitorSection, ReelSection, Scenario, SensorName, SensorSection,
-    WindowSection,
+    EnvelopeSection, MonitorSection, ReelModelName, ReelSection, Scenario, SensedDirection,
+    SensorName, SensorSection, WindowSection,
 };
 
 impl Scenario {
@@ -196,6 +200,72 @@ impl From<&Scenario> for FaultSetup {
             injection: sc.into(),
             reel: (&sc.reel).into(),
             envelope: sc.envelope.to_envelope(),
+        }
+    }
+}
+
+/// `[orbit]`, `[masses]`, `[tether]`, `[reel]`, `[environment]` and `[plant]`: the elastic
+/// plant's parameters.
+impl From<&Scenario> for ElasticParams {
+    fn from(sc: &Scenario) -> Self {
+        let (t, r, e) = (&sc.tether, &sc.reel, &sc.environment);
+        let orbit = Orbit::elliptic(sc.orbit.semi_major_axis_m, sc.orbit.eccentricity);
+        let model = match r.model {
+            ReelModelName::Motor => ReelModel::Motor(DrumParams {
+                radius_m: r.drum_radius_m,
+                inertia_kgm2: r.drum_inertia_kgm2,
+                viscous_nms: r.viscous_nms,
+                coulomb_nm: r.coulomb_nm,
+                static_nm: r.static_nm,
+                max_torque_nm: r.motor_max_torque_nm,
+                brake_nm: r.brake_nm,
+                speed_bandwidth_radps: r.speed_bandwidth_radps,
+            }),
+            ReelModelName::Drive => {
+                let drive = ReelDrive::from(r);
+                if drive.is_ideal() {
+                    ReelModel::Ideal
+                } else {
+                    ReelModel::Lag(Reel::new(&drive, sc.initial.length_rate_mps))
+                }
+            }
+        };
+        Self {
+            orbit: OrbitParams {
+                orbit,
+                initial_true_anomaly_rad: sc.orbit.initial_true_anomaly_rad,
+                inclination_rad: e.inclination_rad,
+            },
+            bodies: BodyParams {
+                main_initial_kg: sc.masses.main_initial_kg,
+                sub_kg: sc.masses.sub_kg,
+                main_drag_area_m2: e.main_drag_area_m2,
+                sub_drag_area_m2: e.sub_drag_area_m2,
+            },
+            tether: TetherParams {
+                density_kg_per_m: t.density_kg_per_m,
+                axial_stiffness_n: t.axial_stiffness_n,
+                damping_ns: t.damping_ns,
+                diameter_m: t.diameter_m,
+                drag_coefficient: t.drag_coefficient,
+                segment_length_m: t.segment_length_m,
+                min_stiffness_length_m: t.min_stiffness_length_m,
+            },
+            reel: ReelParams {
+                model,
+                locked: r.locked,
+            },
+            environment: Environment {
+                mu_m3ps2: orbit.mu_m3ps2,
+                j2: e.j2,
+                drag: e.drag,
+                linear_gradient: false,
+            },
+            sensing: match sc.plant.sensing {
+                SensedDirection::Line => Sensing::Line,
+                SensedDirection::Exit => Sensing::Exit,
+            },
+            courant: sc.plant.courant,
         }
     }
 }

@@ -7,7 +7,7 @@
 //!   defaults) and its validation rules next to it: `system.rs` (`[orbit]`, `[masses]`,
 //!   `[tether]`), `initial.rs`, `control.rs` (`[controller]`, `[stage1]`, `[stage2]`),
 //!   `envelope.rs`, `monitor.rs`, `simulation.rs`, `sensors.rs` (`[sensors]`, `[faults]`),
-//!   `reel.rs`, `link.rs`, `montecarlo.rs`;
+//!   `reel.rs`, `link.rs`, `montecarlo.rs`, `plant.rs` (`[plant]`), `environment.rs`;
 //! - `core_rules.rs`: the flight controller's own rules, not repeated here: the f32 controller
 //!   is built from the scenario and the parameter path of what it rejects is named by scenario
 //!   key (this also catches values beyond f32's range);
@@ -22,13 +22,13 @@
 //! - [`keys`]: `tss-sim scenario keys`, every key with its unit, default and rules, read from
 //!   the schema and from validation itself.
 //!
-//! # Adding a section, say `[environment]`
-//! 1. A file `environment.rs` with `pub struct EnvironmentSection` (`#[derive(Clone, Debug,
+//! # Adding a section, say `[thermal]`
+//! 1. A file `thermal.rs` with `pub struct ThermalSection` (`#[derive(Clone, Debug,
 //!    PartialEq, Serialize, Deserialize)]`, `#[serde(deny_unknown_fields)]`, units in the field
 //!    names, `#[serde(default)]` and a `Default` impl if a file may leave it out) and
 //!    `fn check(&self, v: &mut Validator)` with its rules, naming fields by their dotted keys.
-//! 2. Here: `mod environment;`, `pub use environment::EnvironmentSection;`, a field
-//!    `pub environment: EnvironmentSection` in [`Scenario`], and a line in
+//! 2. Here: `mod thermal;`, `pub use thermal::ThermalSection;`, a field
+//!    `pub thermal: ThermalSection` in [`Scenario`], and a line in
 //!    [`Scenario::problems`] calling its `check`.
 //! 3. If a model takes it, a conversion in `convert.rs` into that model's own parameter type.
 //!    If it configures the flight controller, its rules are `Config::validate`'s: map the
@@ -42,6 +42,7 @@ mod control;
 mod convert;
 mod core_rules;
 mod envelope;
+mod environment;
 mod error;
 mod initial;
 pub mod keys;
@@ -49,6 +50,7 @@ mod link;
 mod load;
 mod monitor;
 mod montecarlo;
+mod plant;
 mod reel;
 mod rules;
 mod schema;
@@ -63,6 +65,7 @@ use serde::{Deserialize, Serialize};
 
 pub use control::{ControllerSection, Stage1Section, Stage2Section};
 pub use envelope::EnvelopeSection;
+pub use environment::EnvironmentSection;
 pub use error::{Problem, ScenarioError};
 pub use initial::InitialSection;
 pub use link::LinkSection;
@@ -72,7 +75,8 @@ pub use montecarlo::{
     dispersible_fields, nominal_value, CriteriaSection, DispersionSection, Distribution,
     MonteCarloSection,
 };
-pub use reel::ReelSection;
+pub use plant::{PlantModel, PlantSection, SensedDirection};
+pub use reel::{ReelModelName, ReelSection};
 pub use schema::{schema, LeafKind, Schema};
 pub use sensors::{
     CorruptSection, FaultsSection, GlitchSection, SensorName, SensorSection, SensorsSection,
@@ -135,6 +139,12 @@ pub struct Scenario {
     /// A host-linked run has no link and ignores it.
     #[serde(default)]
     pub link: LinkSection,
+    /// The plant flown: the rigid rod of Eq. 5 (default) or the elastic truth model.
+    #[serde(default)]
+    pub plant: PlantSection,
+    /// J2, drag and inclination for the elastic plant (default: none, equatorial).
+    #[serde(default)]
+    pub environment: EnvironmentSection,
 }
 
 impl Scenario {
@@ -157,9 +167,40 @@ impl Scenario {
         s.reel.check(&mut v);
         s.monitor.check(&mut v);
         s.link.check(&mut v);
+        s.tether.check(&mut v);
+        s.plant.check(s.controller.period_s, &mut v);
+        s.environment.check(&mut v);
+        s.check_elastic_only(&mut v);
         // The flight controller's own rules, last (it reports the first it finds).
         core_rules::check(s, &mut v);
         v.problems
+    }
+
+    /// The motor reel, J2 and drag exist only in the elastic plant: asking the rigid one for
+    /// them is an error, not a silent no-op.
+    fn check_elastic_only(&self, v: &mut Validator) {
+        if self.plant.model == PlantModel::Elastic {
+            return;
+        }
+        let needs = "needs plant.model = \"elastic\" (the rigid plant has no such model)";
+        v.check(
+            self.reel.model != ReelModelName::Motor,
+            "reel.model",
+            "\"motor\"".to_string(),
+            needs,
+        );
+        v.check(
+            !self.environment.j2,
+            "environment.j2",
+            "true".to_string(),
+            needs,
+        );
+        v.check(
+            !self.environment.drag,
+            "environment.drag",
+            "true".to_string(),
+            needs,
+        );
     }
 
     /// `name` names the default output directory: a non-empty file name.

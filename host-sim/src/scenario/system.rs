@@ -1,7 +1,7 @@
 //! `[orbit]`, `[masses]`, `[tether]`: the physical system the controller flies (Eq. 5 of the
 //! paper). The masses' and the tether's rules (positive masses, ρ ≥ 0, a tether lighter than
-//! the main satellite) are the controller's (`core_rules.rs`); the orbit's perigee is the
-//! scenario's.
+//! the main satellite) are the controller's (`core_rules.rs`); the orbit's perigee and the
+//! elastic plant's tether keys are the scenario's.
 
 use serde::{Deserialize, Serialize};
 
@@ -60,11 +60,86 @@ pub struct MassesSection {
     pub sub_kg: f64,
 }
 
-/// `[tether]`
+/// `[tether]`. The rigid plant uses ρ only; the elastic plant all of it (the defaults are the
+/// 0.5 mm Dyneema line of `scenarios/paper-elastic.toml`, massless unless ρ is given).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TetherSection {
     /// ρ, linear density, kg/m (0 = massless, the paper's run).
     #[serde(default)]
     pub density_kg_per_m: f64,
+    /// EA, axial stiffness, N (elastic plant; default 10 kN).
+    #[serde(default = "default_axial_stiffness_n")]
+    pub axial_stiffness_n: f64,
+    /// Structural (Kelvin–Voigt) damping C: force per unit strain rate, N·s (default 1000).
+    #[serde(default = "default_damping_ns")]
+    pub damping_ns: f64,
+    /// Diameter for drag, m (default 0.5 mm).
+    #[serde(default = "default_diameter_m")]
+    pub diameter_m: f64,
+    /// Drag coefficient in cross-flow (default 2.2, free-molecular flow on a cylinder).
+    #[serde(default = "default_drag_coefficient")]
+    pub drag_coefficient: f64,
+    /// Unstretched length between beads L_s, m (default 1400 m: 20 beads at 30 km).
+    #[serde(default = "default_segment_length_m")]
+    pub segment_length_m: f64,
+    /// A segment is never stiffer than EA over this length, m (default 50 m; ≤ L_s).
+    #[serde(default = "default_min_stiffness_length_m")]
+    pub min_stiffness_length_m: f64,
+}
+
+fn default_axial_stiffness_n() -> f64 {
+    10_000.0
+}
+fn default_damping_ns() -> f64 {
+    1_000.0
+}
+fn default_diameter_m() -> f64 {
+    5e-4
+}
+fn default_drag_coefficient() -> f64 {
+    2.2
+}
+fn default_segment_length_m() -> f64 {
+    1_400.0
+}
+fn default_min_stiffness_length_m() -> f64 {
+    50.0
+}
+
+impl Default for TetherSection {
+    fn default() -> Self {
+        Self {
+            density_kg_per_m: 0.0,
+            axial_stiffness_n: default_axial_stiffness_n(),
+            damping_ns: default_damping_ns(),
+            diameter_m: default_diameter_m(),
+            drag_coefficient: default_drag_coefficient(),
+            segment_length_m: default_segment_length_m(),
+            min_stiffness_length_m: default_min_stiffness_length_m(),
+        }
+    }
+}
+
+impl TetherSection {
+    /// The elastic plant's keys: EA > 0; C, d, C_d ≥ 0; 0 < l_k ≤ L_s. (ρ's rules are the
+    /// controller's mass model's, `core_rules`.)
+    pub(super) fn check(&self, v: &mut Validator) {
+        v.positive("tether.axial_stiffness_n", self.axial_stiffness_n);
+        v.non_negative("tether.damping_ns", self.damping_ns);
+        v.non_negative("tether.diameter_m", self.diameter_m);
+        v.non_negative("tether.drag_coefficient", self.drag_coefficient);
+        let segment_ok = v.positive("tether.segment_length_m", self.segment_length_m);
+        if v.positive("tether.min_stiffness_length_m", self.min_stiffness_length_m) && segment_ok {
+            v.check(
+                self.min_stiffness_length_m <= self.segment_length_m,
+                "tether.min_stiffness_length_m",
+                num(self.min_stiffness_length_m),
+                &format!(
+                    "must not exceed tether.segment_length_m = {}",
+                    num(self.segment_length_m)
+                ),
+            );
+        }
+    }
 }
