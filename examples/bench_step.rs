@@ -4,9 +4,9 @@
 //! how many instructions one [`Controller::step`] takes (median, 99th percentile, worst) and
 //! where they go:
 //!
-//! 1. `replay`: the firmware's built-in input (`src/firmware/replay_data.rs`): the first 900 s
+//! 1. `replay`: the firmware's built-in input (`tss_reel::recordings::replay`): the first 720 s
 //!    of the paper's mission, with the firmware's injected sensor dropout (ticks 400..450);
-//! 2. `mission`: the whole 20-hour paper mission (`examples/bench_step/mission.rs`: recorded
+//! 2. `mission`: the whole 20-hour paper mission (`tss_reel::recordings::mission`: recorded
 //!    every 5 s by `tests/bench_data.rs`, interpolated to 1 s): deploy, keep, slew, retrieve,
 //!    keep, 72 001 steps.
 //!
@@ -40,38 +40,17 @@
 //! step is the sensor validation (the monitor's checks), the sequencer and health state machine,
 //! dead reckoning and filling in the output.
 //!
-//! On the host this file compiles to an empty program.
-#![cfg_attr(target_os = "none", no_std, no_main)]
+//! Needs the `firmware` feature and the bare-metal target (`required-features` in Cargo.toml).
+#![no_std]
+#![no_main]
 #![deny(unsafe_code)]
 
-/// Host stub: the benchmark runs only on the target (see the crate docs).
-#[cfg(not(target_os = "none"))]
-fn main() {}
-
-// The global logger and the panic handler, as in the firmware.
-#[cfg(target_os = "none")]
-use defmt_semihosting as _;
-#[cfg(target_os = "none")]
-use panic_probe as _;
-
-/// The firmware's exits and fault handlers (HardFault => failing exit), shared file.
-#[cfg(target_os = "none")]
-#[path = "../src/firmware/exit.rs"]
-mod exit;
-
-/// The firmware's built-in input: the first 900 s of the paper's mission.
-#[cfg(target_os = "none")]
-#[allow(dead_code)]
-#[path = "../src/firmware/replay_data.rs"]
-mod replay_data;
-
+use tss_reel::firmware::exit;
 /// The whole paper mission, recorded every 5 s, interpolated to 1 s.
-#[cfg(target_os = "none")]
-#[allow(dead_code)]
-#[path = "bench_step/mission.rs"]
-mod mission;
+use tss_reel::recordings::mission;
+/// The firmware's built-in input: the first 720 s of the paper's mission.
+use tss_reel::recordings::replay;
 
-#[cfg(target_os = "none")]
 mod bench {
     use core::hint::black_box;
     use cortex_m::peripheral::{syst::SystClkSource, SYST};
@@ -606,7 +585,6 @@ mod bench {
     }
 }
 
-#[cfg(target_os = "none")]
 #[cortex_m_rt::entry]
 fn main() -> ! {
     use bench::{Meter, INSTRUCTIONS_PER_COUNT, K};
@@ -638,13 +616,13 @@ fn main() -> ! {
     bench::measure(
         &meter,
         "replay",
-        replay_data::SAMPLES.len() as u32,
-        replay_data::ORBIT_RATE_RADPS,
+        replay::SAMPLES.len() as u32,
+        replay::ORBIT_RATE_RADPS,
         |tick| {
-            if (replay_data::DROPOUT_FROM_TICK..replay_data::DROPOUT_UNTIL_TICK).contains(&tick) {
+            if (replay::DROPOUT_FROM_TICK..replay::DROPOUT_UNTIL_TICK).contains(&tick) {
                 None
             } else {
-                replay_data::SAMPLES.get(tick as usize).copied()
+                replay::SAMPLES.get(tick as usize).copied()
             }
         },
     );

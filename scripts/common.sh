@@ -12,8 +12,10 @@ case ":$PATH:" in
   *) export PATH="$CARGO_BIN_DIR:$PATH" ;;
 esac
 
-# The firmware's target, its flight build and where that build lands.
+# The firmware's target, the package feature every MCU program needs (Cargo.toml), its flight
+# build and where that build lands.
 FW_TARGET=thumbv7em-none-eabihf
+FW_FEATURES=firmware
 FW_PROFILE=firmware
 # shellcheck disable=SC2034 # used by the scripts that source this file
 FW_ELF=target/$FW_TARGET/$FW_PROFILE/tss-reel
@@ -47,5 +49,21 @@ llvm_tool() {
 
 # Builds the flight firmware (profile `firmware`).
 build_firmware() {
-  cargo build --profile "$FW_PROFILE" --target "$FW_TARGET" --bin tss-reel
+  cargo build --profile "$FW_PROFILE" --target "$FW_TARGET" --features "$FW_FEATURES" --bin tss-reel
+}
+
+# The real board's firmware (NUCLEO-G474RE, src/board/nucleo_g474re.rs): its feature, bin and
+# flight ELF (same target and profile; `cargo fw-board` builds the same thing). It cannot run
+# here: the scripts build, lint and measure it.
+BOARD_FEATURES=nucleo-g474re
+BOARD_BIN=tss-reel-nucleo-g474re
+# shellcheck disable=SC2034 # used by the scripts that source this file
+BOARD_ELF=target/$FW_TARGET/$FW_PROFILE/$BOARD_BIN
+# The board's control path for scripts/panic-check: the outer law's cycle and the inner loop.
+# shellcheck disable=SC2034
+BOARD_PANIC_ROOT='^(tss_reel_nucleo_g474re::board::Outer::control(::h[0-9a-f]+)?|SysTick)$'
+
+# Builds the board's flight firmware (profile `firmware`).
+build_board() {
+  cargo build --profile "$FW_PROFILE" --target "$FW_TARGET" --features "$BOARD_FEATURES" --bin "$BOARD_BIN"
 }

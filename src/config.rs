@@ -157,7 +157,7 @@ pub struct Config<T> {
 }
 
 impl<T: Real> Config<T> {
-    /// The paper's Section 6 (SPEC §7): 1 s period, ρ = 0, l̇0 = 0.1 m/s, k1 = 0.0057 s⁻¹,
+    /// The paper's Section 6 (docs/equations.md §7): 1 s period, ρ = 0, l̇0 = 0.1 m/s, k1 = 0.0057 s⁻¹,
     /// k2 = 9.8696e-6 s⁻², c = 1e-3 s⁻¹ then 5e-4 s⁻¹, slew 6.2932e-4 rad/s, stage 2 at
     /// t = 8 h.
     ///
@@ -293,7 +293,7 @@ impl<T: Real> Config<T> {
                 return Err(ConfigError::new(name, s.low_length_m, Rule::BandInverted));
             }
         }
-        // Deployment needs α_r on the deployment side, (−π/2, 0) (Eq. 33, SPEC §9.5);
+        // Deployment needs α_r on the deployment side, (−π/2, 0) (Eq. 33, docs/equations.md §9.5);
         // retrieval on the retrieval side, (0, π/2).
         let half_pi = T::from_f64(core::f64::consts::FRAC_PI_2);
         let deploy = self.stage1.schedule.low_angle_rad;
@@ -388,7 +388,7 @@ pub(crate) fn above<T: Real>(param: &'static str, v: T, min: T) -> Result<(), Co
 
 /// What a parameter violates.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Rule {
     /// NaN or infinite.
     NotFinite,
@@ -418,7 +418,7 @@ pub enum Rule {
 
 /// A rejected parameter: its name (the field path in [`Config`]), its value and the rule.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct ConfigError {
     /// Field path, e.g. `gains.k1_per_s`.
     pub param: &'static str,

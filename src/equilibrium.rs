@@ -1,5 +1,5 @@
 //! Existence of the swing equilibria and its extent over the orbit (Eqs. 6–15, Figs. 2–3;
-//! SPEC §3).
+//! docs/equations.md §3).
 //!
 //! An equilibrium X_e = (α_e, β_e) of Eqs. 5b–5c with l̇/l frozen has sin2β_e = 0 and an in-plane
 //! angle given by Eq. 7. It exists only while the *normalised reel rate*
@@ -40,7 +40,7 @@ use crate::real::Real;
 const F_CONST: f64 = 1.5;
 /// Coefficient of e·sinθ in F1 (Eq. 10).
 const F_SIN: f64 = 2.0;
-/// The eccentricity at which the whole-orbit extent vanishes: min F1 = 1.5 − 2e = 0 (SPEC §3).
+/// The eccentricity at which the whole-orbit extent vanishes: min F1 = 1.5 − 2e = 0 (docs/equations.md §3).
 pub const ECCENTRICITY_LIMIT: f64 = 0.75;
 
 /// Convergence tolerance of the extent root finder on the true anomaly θ*, rad.
@@ -260,7 +260,7 @@ pub struct Extent<T> {
 
 /// min_θ Depl(e, θ) and where it is (Fig. 3a), by a bounded safeguarded Newton iteration.
 ///
-/// Why the bracket holds the global minimum (SPEC §3): F1(θ) − F1(−θ) = 4e sinθ (1 + e cosθ), so
+/// Why the bracket holds the global minimum (docs/equations.md §3): F1(θ) − F1(−θ) = 4e sinθ (1 + e cosθ), so
 /// the minimum has sinθ ≤ 0; and F1(θ) − F1(−π − θ) = 2e cosθ (1.5 + 2e sinθ), so for e ≤ 0.75
 /// (second factor ≥ 0) it has cosθ ≤ 0, θ* ∈ [−π, −π/2], while for e > 0.75 (min F1 < 0, second
 /// factor < 0 at the minimum) cosθ ≥ 0, θ* ∈ [−π/2, 0]. On that bracket g = F1′/e goes from

@@ -1,7 +1,7 @@
 //! Single-precision sine and cosine that never leave the FPU's precision.
 //!
 //! `libm::sinf` evaluates in f64, which the Cortex-M4F's single-precision FPU emulates in
-//! software (about 1 200 instructions a call, SPEC §8). The law needs sin 2α and cos 2α with
+//! software (about 1 200 instructions a call, docs/equations.md §8). The law needs sin 2α and cos 2α with
 //! |2α| ≤ 2π, to a few f32 ulps. This module does it in f32 only, from a table:
 //!
 //! 1. x = k·h + r with h = 2π/128 and k = round(x/h), r = (x − k·H1) − k·H2 (Cody–Waite:

@@ -11,7 +11,7 @@ use crate::controller::{Controller, Input, Output};
 
 /// What kind of failure a sensor or actuator reported.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
 pub enum ErrorKind {
     /// No new sample this period (dropout, timeout, link loss).
@@ -54,7 +54,7 @@ pub trait LengthSensor: ErrorType {
 
 /// One reading of the in-plane swing sensor.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Swing {
     /// In-plane angle α, rad.
     pub alpha_rad: f32,
@@ -120,7 +120,7 @@ pub struct Devices<L, S, O, R> {
 /// What one control cycle did besides stepping the controller (its output, already sent to
 /// the reel unless `reel_error` is set, is [`Controller::output`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Cycle {
     /// The first sensor error of this period, if any (the controller treated it as a dropout).
     pub sensor_error: Option<ErrorKind>,

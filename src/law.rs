@@ -1,4 +1,4 @@
-//! The range-rate control law (Eqs. 26–30, SPEC §5): circular orbit, in-plane (β = 0).
+//! The range-rate control law (Eqs. 26–30, docs/equations.md §5): circular orbit, in-plane (β = 0).
 //!
 //! With δ = α − α_r, the paper's law (Eq. 27)
 //!
@@ -12,7 +12,7 @@
 //!
 //! **Eq. 27 is implicit** when α_r depends on l: α̇_r = p·l̇_real + r (p = ∂α_r/∂l,
 //! r = ∂α_r/∂t), so δ̇ contains the rate being computed. [`solve`] solves Eqs. 27 + 29 exactly
-//! for y = l̇_real as the root of (SPEC §5)
+//! for y = l̇_real as the root of (docs/equations.md §5)
 //!
 //! ```text
 //!   (y − E l̇0)(w − p y) = (1 − E) L′ (G0 − k1 p y),
@@ -113,9 +113,9 @@ pub struct LawInput<T> {
     pub gains: Gains<T>,
 }
 
-/// Why the law has no valid solution at this instant (SPEC §5, the law's singular points).
+/// Why the law has no valid solution at this instant (docs/equations.md §5, the law's singular points).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum LawFault {
     /// b ≤ 0 in the implicit solve: n + δ̇ has reached zero (the Eq. 27 denominator) or
     /// changed sign, so the command would be unbounded or the wrong root.
@@ -157,10 +157,10 @@ pub struct LawOutput<T> {
 
 /// Smallest admissible value of b relative to n: below this the Eq. 27 denominator n + δ̇ is
 /// treated as singular. In the paper's run (n + δ̇)/n falls to about 0.06 in the first minutes
-/// (SPEC §5), so 1 % leaves a factor-six margin while bounding the command's sensitivity.
+/// (docs/equations.md §5), so 1 % leaves a factor-six margin while bounding the command's sensitivity.
 pub const MIN_DENOMINATOR_FRACTION: f64 = 0.01;
 
-/// Solves Eqs. 27 + 29 for the reel-rate command y = l̇_real (SPEC §5).
+/// Solves Eqs. 27 + 29 for the reel-rate command y = l̇_real (docs/equations.md §5).
 ///
 /// Returns a [`LawFault`] (never a non-finite number) at the law's singular points.
 pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
@@ -266,7 +266,7 @@ pub fn explicit_eq27<T: Real>(x: &LawInput<T>, delta_rate_radps: T) -> T {
 
 /// The commanded reel acceleration ÿ = d(l̇_real)/dt, the time derivative of Eq. 29 with
 /// Eq. 27 inside it (Eq. 30, with the sign of its `[(1−e^{−cτ}) l̇_real + c l e^{−cτ}] l̇/l`
-/// term corrected, SPEC §9.3).
+/// term corrected, docs/equations.md §9.3).
 ///
 /// δ̈ comes from the in-plane dynamics (Eq. 26 / 5b, circular orbit, β = 0) with l̇ = y, and
 /// α̈_r = (∂²α_r/∂l²) y² + p ÿ, which makes the result implicit again but linear in ÿ:

@@ -17,7 +17,8 @@
 //! ```text
 //! offset  size  field
 //! 0       1     version            = VERSION; any other value is LinkError::Version
-//! 1       4     seq      u32       sender's frame counter, +1 per new frame (a repeat keeps it)
+//! 1       4     seq      u32       sender's frame counter from 0, +1 per new frame (a repeat
+//!                                  keeps it)
 //! 5       1     kind     u8        0 Hello, 1 Sample, 2 Command, 3 End, 4 Report
 //! 6       n     body               the kind's fields, in declaration order (below)
 //! 6+n     4     crc      u32       CRC-32/ISO-HDLC over bytes 0 .. 6+n
@@ -38,7 +39,8 @@
 //!         length_estimate_m f32, equilibrium_margin f32,
 //!         phase u8, health u8, fault u8 (see `fault_code`), flags u32
 //! End     (plant → firmware, once at the end, n = 4)
-//!         ticks u32 (control periods the plant ran)
+//!         ticks u32 (control periods the plant ran); its seq follows the last sample's, so
+//!         the firmware counts sample frames lost at the end as gaps
 //! Report  (firmware → plant, the answer to End, n = 4 × 15)
 //!         the firmware's LinkCounters, then commands u32 (sent), then digest u32 (FNV-1a over
 //!         the bit patterns of every rate command, as the replay mission's)
@@ -77,6 +79,11 @@ pub const MAX_FRAME_LEN: usize = 80;
 /// Largest frame on the wire: COBS adds one byte per 254 (and one), plus the `0x00` delimiter.
 pub const MAX_WIRE_LEN: usize = MAX_FRAME_LEN + MAX_FRAME_LEN / 254 + 2;
 
+/// Most control periods of one PIL run (ticks 0 ..= `MAX_TICKS` − 1): the firmware ends a
+/// longer run as a failure, and the plant refuses such a scenario before it starts. The
+/// paper's 20-h mission is 72 001 ticks.
+pub const MAX_TICKS: u32 = 200_000;
+
 /// The wire delimiter between frames.
 pub const DELIMITER: u8 = 0x00;
 
@@ -87,7 +94,7 @@ const CRC32: crc::Crc<u32, crc::NoTable> =
 
 /// Why a frame was rejected.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum LinkError {
     /// The bytes between two delimiters are not a valid COBS encoding.
     Cobs,
@@ -113,7 +120,7 @@ pub enum LinkError {
 /// What arrived for one control period, as the firmware reports it back in each
 /// [`Command::sample`] (and counts in [`LinkCounters`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum SampleStatus {
     /// A valid sample frame for this tick.
     Fresh = 0,
@@ -140,7 +147,7 @@ impl SampleStatus {
 
 /// `Hello`: the firmware announces itself once, before the first sample.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Hello {
     /// [`config_digest`] of the controller configuration the firmware flies.
     #[serde(with = "postcard::fixint::le")]
@@ -160,7 +167,7 @@ pub const SAMPLE_MISSING: u8 = 1;
 
 /// `Sample`: one control period's sensor readings, plant → firmware.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Sample {
     /// The control period this sample belongs to (the authority on time in PIL).
     #[serde(with = "postcard::fixint::le")]
@@ -182,7 +189,7 @@ pub struct Sample {
 /// It carries every field of [`Output<f32>`], so the plant side rebuilds the exact output
 /// ([`Command::to_output`]) and writes the same history as a host-linked run.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Command {
     /// The tick of the output.
     #[serde(with = "postcard::fixint::le")]
@@ -222,7 +229,7 @@ pub struct Command {
 
 /// `End`: the plant's mission is over; the firmware answers with a [`Report`] and stops.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct End {
     /// Control periods the plant ran.
     #[serde(with = "postcard::fixint::le")]
@@ -231,7 +238,7 @@ pub struct End {
 
 /// What a receiver saw on the link (each field a count of frames or periods).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct LinkCounters {
     /// Valid frames of the expected kind that were used.
     #[serde(with = "postcard::fixint::le")]
@@ -309,7 +316,7 @@ impl LinkCounters {
 
 /// `Report`: the firmware's link counters and command digest, its answer to [`End`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Report {
     /// The firmware's receive-side counters.
     pub counters: LinkCounters,
@@ -323,7 +330,7 @@ pub struct Report {
 
 /// One message: the frame's kind and body.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Message {
     /// Kind 0, firmware → plant.
     Hello(Hello),
@@ -342,7 +349,7 @@ pub const KINDS: u8 = 5;
 
 /// A decoded frame: header and message (the CRC is checked and dropped).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Frame {
     /// Protocol version ([`VERSION`]).
     pub version: u8,
@@ -390,10 +397,12 @@ pub fn decode(encoded: &[u8]) -> Result<Frame, LinkError> {
         return Err(LinkError::Truncated);
     }
     let mut raw = [0u8; MAX_FRAME_LEN];
-    let n = cobs::decode(encoded, &mut raw).map_err(|e| match e {
-        cobs::DecodeError::TargetBufTooSmall => LinkError::Overflow,
-        _ => LinkError::Cobs,
-    })?;
+    let n = cobs::decode(encoded, &mut raw)
+        .map_err(|e| match e {
+            cobs::DecodeError::TargetBufTooSmall => LinkError::Overflow,
+            _ => LinkError::Cobs,
+        })?
+        .frame_size();
     let raw = raw.get(..n).ok_or(LinkError::Overflow)?;
     if raw.len() < HEADER_LEN + CRC_LEN {
         return Err(LinkError::Truncated);
@@ -491,7 +500,7 @@ impl FrameReader {
 
 /// What a [`SampleGate`] made of one valid sample frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Gate {
     /// The sample for the awaited tick (or a later one: the frame's tick is the authority).
     Accept(Sample),
@@ -504,24 +513,34 @@ pub enum Gate {
 /// The receiving side's sequence and tick checks on sample frames, with the counts in
 /// [`LinkCounters`]. A discarded frame does not use up the period: the receiver keeps waiting
 /// for the right one (so a repeated frame cannot push the receiver ahead of the sender).
+///
+/// The sender numbers its frames from 0 and its [`End`] frame carries the number after its last
+/// sample, so frames lost before the first one that arrives and after the last one are counted
+/// as gaps too ([`SampleGate::close`]): the count is exact whichever frames are lost.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SampleGate {
+    /// Sequence number and tick of the newest sample frame seen (`None`: none yet).
     last: Option<(u32, u32)>,
 }
 
 impl SampleGate {
-    /// A gate that has accepted nothing yet.
+    /// A gate that has seen nothing yet (the next frame is expected to be number 0).
     pub const fn new() -> Self {
         Self { last: None }
     }
 
-    /// Judges a valid sample frame `seq`/`sample` while the receiver waits for tick `awaited`
-    /// (`None` before the first); counts duplicates, late frames and sequence gaps.
+    /// The sequence number the next new frame should carry.
+    fn expected_seq(&self) -> u32 {
+        self.last.map_or(0, |(seq, _)| seq.saturating_add(1))
+    }
+
+    /// Judges a valid sample frame `seq`/`sample` while the receiver waits for tick `awaited`;
+    /// counts duplicates, late frames and sequence gaps.
     pub fn check(
         &mut self,
         seq: u32,
         sample: Sample,
-        awaited: Option<u32>,
+        awaited: u32,
         counters: &mut LinkCounters,
     ) -> Gate {
         if let Some((last_seq, last_tick)) = self.last {
@@ -533,17 +552,24 @@ impl SampleGate {
                 counters.out_of_order = counters.out_of_order.saturating_add(1);
                 return Gate::OutOfOrder;
             }
-            let gap = seq - last_seq - 1;
-            counters.seq_gaps = counters.seq_gaps.saturating_add(gap);
         }
+        let gap = seq.saturating_sub(self.expected_seq());
+        counters.seq_gaps = counters.seq_gaps.saturating_add(gap);
         // Seen, so it is no gap, whether or not it is used.
         self.last = Some((seq, sample.tick));
-        if awaited.is_some_and(|t| sample.tick < t) {
+        if sample.tick < awaited {
             counters.out_of_order = counters.out_of_order.saturating_add(1);
             return Gate::OutOfOrder;
         }
         counters.frames_ok = counters.frames_ok.saturating_add(1);
         Gate::Accept(sample)
+    }
+
+    /// The sender's [`End`] frame, number `end_seq`, closed the run: counts the frames lost
+    /// after the last one seen (all of them if none arrived).
+    pub fn close(&mut self, end_seq: u32, counters: &mut LinkCounters) {
+        let gap = end_seq.saturating_sub(self.expected_seq());
+        counters.seq_gaps = counters.seq_gaps.saturating_add(gap);
     }
 }
 
@@ -1028,25 +1054,49 @@ mod tests {
 
     #[test]
     fn the_gate_drops_duplicates_and_late_frames_and_counts_gaps() {
-        let s = |tick| Sample {
+        let mut g = SampleGate::new();
+        let mut c = LinkCounters::default();
+        assert_eq!(g.check(0, s(0), 0, &mut c), Gate::Accept(s(0)));
+        assert_eq!(g.check(0, s(0), 1, &mut c), Gate::Duplicate);
+        assert_eq!(g.check(2, s(2), 1, &mut c), Gate::Accept(s(2)));
+        assert_eq!(g.check(1, s(1), 3, &mut c), Gate::OutOfOrder);
+        assert_eq!(g.check(3, s(3), 3, &mut c), Gate::Accept(s(3)));
+        g.close(4, &mut c);
+        assert_eq!(
+            (c.frames_ok, c.duplicates, c.out_of_order, c.seq_gaps),
+            (3, 1, 1, 1)
+        );
+    }
+
+    /// Issue 16 §4: frames lost before the first that arrives and after the last are gaps too.
+    #[test]
+    fn the_gate_counts_frames_lost_at_the_start_and_the_end() {
+        let mut g = SampleGate::new();
+        let mut c = LinkCounters::default();
+        // Frames 0 and 1 (ticks 0 and 1) lost; the first to arrive is number 2.
+        assert_eq!(g.check(2, s(2), 0, &mut c), Gate::Accept(s(2)));
+        assert_eq!(c.seq_gaps, 2);
+        assert_eq!(g.check(3, s(3), 3, &mut c), Gate::Accept(s(3)));
+        // Frames 4 and 5 lost; End is number 6.
+        g.close(6, &mut c);
+        assert_eq!(c.seq_gaps, 4);
+
+        // Nothing arrives at all: every frame before End is a gap.
+        let mut g = SampleGate::new();
+        let mut c = LinkCounters::default();
+        g.close(7, &mut c);
+        assert_eq!(c.seq_gaps, 7);
+    }
+
+    fn s(tick: u32) -> Sample {
+        Sample {
             tick,
             status: SAMPLE_VALID,
             length_m: 1.0,
             alpha_rad: 0.0,
             alpha_rate_radps: 0.0,
             orbit_rate_radps: 1e-3,
-        };
-        let mut g = SampleGate::new();
-        let mut c = LinkCounters::default();
-        assert_eq!(g.check(0, s(0), None, &mut c), Gate::Accept(s(0)));
-        assert_eq!(g.check(0, s(0), Some(1), &mut c), Gate::Duplicate);
-        assert_eq!(g.check(2, s(2), Some(1), &mut c), Gate::Accept(s(2)));
-        assert_eq!(g.check(1, s(1), Some(3), &mut c), Gate::OutOfOrder);
-        assert_eq!(g.check(3, s(3), Some(3), &mut c), Gate::Accept(s(3)));
-        assert_eq!(
-            (c.frames_ok, c.duplicates, c.out_of_order, c.seq_gaps),
-            (3, 1, 1, 1)
-        );
+        }
     }
 
     #[test]

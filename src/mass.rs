@@ -1,4 +1,4 @@
-//! Mass model of the main satellite, sub-satellite and tether (SPEC §1, the paper's
+//! Mass model of the main satellite, sub-satellite and tether (docs/equations.md §1, the paper's
 //! nomenclature and Eq. 2).
 //!
 //! The tether (linear density ρ) is paid out of the main satellite, so m1 = m01 − ρl while the
@@ -35,7 +35,7 @@ pub struct MassCoefficients<T> {
     pub mu1: T,
     /// μ2 = (m2 + m_t/2)/(m2 + m_t) (Eq. 5a).
     pub mu2: T,
-    /// μ3 = 2[m1(m2 + m_t/2)/(M M*) − 1] = l·(dM*/dl)/M* (Eqs. 5b, 5c; SPEC §9.1).
+    /// μ3 = 2[m1(m2 + m_t/2)/(M M*) − 1] = l·(dM*/dl)/M* (Eqs. 5b, 5c; docs/equations.md §9.1).
     pub mu3: T,
 }
 
@@ -85,7 +85,7 @@ impl<T: Real> MassModel<T> {
     }
 
     /// μ̇3 = ρ l̇ [−m01(m2 + m_t/2)² + ⅓M(m01 m2 + m_t²/2)]/(M M*)², 1/s (the paper's
-    /// expression after Eq. 30; SPEC §1). Zero for a massless tether.
+    /// expression after Eq. 30; docs/equations.md §1). Zero for a massless tether.
     pub fn mu3_rate_per_s(&self, length_m: T, length_rate_mps: T) -> T {
         let c = self.coefficients(length_m);
         let two = T::from_f64(2.0);
@@ -124,7 +124,7 @@ mod tests {
     #[test]
     fn thin_tether_at_30_km_matches_hand_values() {
         // ρ = 1e-3 kg/m, l = 30 km: m_t = 30 kg, m1 = 9970 kg, M = 10100 kg (worked by hand
-        // from SPEC §1).
+        // from docs/equations.md §1).
         let c = thin_tether().coefficients(30_000.0);
         assert!((c.tether_kg - 30.0).abs() < 1e-12);
         assert!((c.main_kg - 9970.0).abs() < 1e-12);
@@ -138,7 +138,7 @@ mod tests {
 
     #[test]
     fn mu3_is_log_derivative_of_reduced_mass() {
-        // μ3 = l (dM*/dl) / M*  (SPEC §1).
+        // μ3 = l (dM*/dl) / M*  (docs/equations.md §1).
         let m = thin_tether();
         for &l in &[10.0, 2_000.0, 30_000.0, 100_000.0] {
             let h = 1e-3 * l;

@@ -12,7 +12,7 @@ pub use crate::config::MonitorConfig;
 
 /// One control period's sensor sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Input<T> {
     /// Tick count of this sample (mission time = tick × period).
     pub tick: u32,
@@ -28,7 +28,7 @@ pub struct Input<T> {
 
 /// Which sensed value was rejected, and why.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Sensor {
     /// No sample arrived for this tick (dropout).
     Missing,

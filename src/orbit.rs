@@ -1,11 +1,11 @@
-//! The orbit of the system's centre of mass (SPEC §0): Keplerian, circular or elliptic.
+//! The orbit of the system's centre of mass (docs/equations.md §0): Keplerian, circular or elliptic.
 //!
 //! The controller itself only needs the orbit rate `n` (a sensed input on each step); the
 //! stability analysis (Eqs. 6–19) and the simulator need the full elliptic kinematics.
 
 use crate::real::Real;
 
-/// Earth's gravitational parameter μ, m³/s² (IERS/WGS-84 value, SPEC §0).
+/// Earth's gravitational parameter μ, m³/s² (IERS/WGS-84 value, docs/equations.md §0).
 pub const EARTH_MU_M3PS2: f64 = 3.986_004_418e14;
 
 /// A Keplerian orbit of the centre of mass, described by semi-major axis and eccentricity.
@@ -36,7 +36,7 @@ impl<T: Real> Orbit<T> {
         }
     }
 
-    /// Mean motion ω = √(μ/a³), rad/s (SPEC §0; the ω of Eqs. 7–13).
+    /// Mean motion ω = √(μ/a³), rad/s (docs/equations.md §0; the ω of Eqs. 7–13).
     pub fn mean_motion_radps(&self) -> T {
         let a = self.semi_major_axis_m;
         (self.mu_m3ps2 / (a * a * a)).sqrt()

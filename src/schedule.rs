@@ -1,5 +1,5 @@
 //! Reference-angle schedules α_r(l) of Eqs. 34 and 35, with quintic Hermite transitions
-//! (SPEC §6), and the stage-2 slew.
+//! (docs/equations.md §6), and the stage-2 slew.
 //!
 //! Both of the paper's schedules have the same shape: a straight piece below a transition band,
 //! a straight piece above it, and a transition function f(l) inside it whose value, slope and
@@ -22,7 +22,7 @@ use crate::real::Real;
 pub struct RefAngle<T> {
     /// α_r, rad.
     pub angle_rad: T,
-    /// ∂α_r/∂l, rad/m (the `p` of SPEC §5).
+    /// ∂α_r/∂l, rad/m (the `p` of docs/equations.md §5).
     pub slope_rad_per_m: T,
     /// ∂²α_r/∂l², rad/m² (needed by the Eq. 30 acceleration).
     pub curvature_rad_per_m2: T,
@@ -87,7 +87,7 @@ impl<T: Real> BandSchedule<T> {
         let (lo, hi) = (f(self.low_length_m), f(self.high_length_m));
         let h = hi - lo;
         let end = |length: T, angle: T, slope: T, far_angle: T, far_slope: T, dir: f64| {
-            // The quintic written around this end (SPEC §6): in u = distance from this end in
+            // The quintic written around this end (docs/equations.md §6): in u = distance from this end in
             // band widths (du/dl = dir/h), g(0) = f_e, g'(0) = dir·h·k_e, g'(1) = dir·h·k_far,
             // g''(0) = g''(1) = 0:  g = f_e + g1 u + u³(c3 + u(c4 + u c5)).
             let g1 = dir * h * f(slope);
@@ -158,7 +158,7 @@ struct BandEnd<T> {
     q20_rad_per_m2: T,
 }
 
-/// A [`BandSchedule`] ready to evaluate every period: the transition quintic of SPEC §6 written
+/// A [`BandSchedule`] ready to evaluate every period: the transition quintic of docs/equations.md §6 written
 /// around each end of the band, its coefficients computed once (in f64) by
 /// [`BandSchedule::prepare`].
 ///
@@ -232,7 +232,7 @@ impl<T: Real> PreparedBand<T> {
 }
 
 /// The stage-2 reference: α_r slews from 0 at `slew_rate_radps` until it meets the Eq. 35
-/// schedule, which it then follows (SPEC §6: "from 0 to 18° in 500 s along the slope of
+/// schedule, which it then follows (docs/equations.md §6: "from 0 to 18° in 500 s along the slope of
 /// 6.2932e-4", clamped at the plateau, i.e. 499.2 s).
 ///
 /// Written as α_r = min(ramp(τ), A(l)) for a positive plateau, so the hand-over is continuous
@@ -250,7 +250,7 @@ pub struct SlewedSchedule<T> {
 pub struct Reference<T> {
     /// α_r and its length derivatives.
     pub angle: RefAngle<T>,
-    /// ∂α_r/∂t at fixed l, rad/s (the `r` of SPEC §5; non-zero only during a slew).
+    /// ∂α_r/∂t at fixed l, rad/s (the `r` of docs/equations.md §5; non-zero only during a slew).
     pub time_rate_radps: T,
     /// `true` while the slew is still below the schedule.
     pub slewing: bool,

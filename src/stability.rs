@@ -1,7 +1,7 @@
-//! Stability of the swing equilibria (Eqs. 16–19, SPEC §4) and of the closed loop (Eq. 28).
+//! Stability of the swing equilibria (Eqs. 16–19, docs/equations.md §4) and of the closed loop (Eq. 28).
 //!
 //! About an equilibrium (α_e, β_e) with β_e ∈ {0, ±π/2} and l̇/l frozen, Eqs. 5b–5c linearise
-//! into two decoupled second-order modes (Eq. 17, without the paper's stray θ̇ — SPEC §9.2):
+//! into two decoupled second-order modes (Eq. 17, without the paper's stray θ̇ — docs/equations.md §9.2):
 //!
 //! ```text
 //!     in-plane:      λ² + (2+μ3)(l̇/l) λ + (3μ/R³) cos2α_e                    = 0
@@ -178,7 +178,7 @@ pub struct FrozenCoefficients<T> {
     pub gravity_gradient_per_s2: T,
     /// l̇/l, 1/s (> 0 deploying, < 0 retrieving, 0 station keeping).
     pub length_rate_ratio_per_s: T,
-    /// μ3 (SPEC §1), dimensionless.
+    /// μ3 (docs/equations.md §1), dimensionless.
     pub mu3: T,
 }
 

@@ -13,8 +13,8 @@
 //! blend crossing zero) is measured against 1 mm/s: a relative error of a near-zero command is
 //! not meaningful, and 1 mm/s is below what a reel encoder resolves in one period.
 //!
-//! The sequences: the firmware's replay (`src/firmware/replay_data.rs`, 720 s with its sensor
-//! dropout), the whole 20-hour paper mission (`examples/bench_step/mission.rs`, interpolated to
+//! The sequences: the firmware's replay (`src/recordings/replay.rs`, 720 s with its sensor
+//! dropout), the whole 20-hour paper mission (`src/recordings/mission.rs`, interpolated to
 //! 1 s), and random states across the range the sensor checks accept. Each test prints its
 //! figures (`cargo test --test accuracy_f64 -- --nocapture`).
 //!
@@ -27,13 +27,7 @@
 
 use tss_reel::controller::{Config, Controller, Health, Input, Output};
 
-#[path = "../src/firmware/replay_data.rs"]
-#[allow(dead_code)]
-mod replay_data;
-
-#[path = "../examples/bench_step/mission.rs"]
-#[allow(dead_code)]
-mod mission;
+use tss_reel::recordings::{mission, replay as replay_data};
 
 /// Commands slower than this are compared against it instead of their own size, m/s.
 const RATE_FLOOR_MPS: f64 = 1e-3;

@@ -1,8 +1,8 @@
 //! The benchmarks' recording of the whole paper mission, and the proof that it is fit for use.
 //!
-//! `examples/bench_step/mission_data.rs` holds the 20-hour mission of `scenarios/paper.toml` as
+//! `src/recordings/mission/data.rs` holds the 20-hour mission of `scenarios/paper.toml` as
 //! the reel MCU senses it, one sample every `EVERY_S` seconds (the full 1 s recording would not
-//! fit the MCU's flash); `examples/bench_step/mission.rs` interpolates it back to 1 s ticks. The
+//! fit the MCU's flash); `src/recordings/mission.rs` interpolates it back to 1 s ticks. The
 //! target benchmark (`examples/bench_step.rs`) and the f32-vs-f64 accuracy test replay it.
 //!
 //! - `mission_data_is_the_recorded_mission`: the checked-in data agrees with what `tss-sim`
@@ -18,8 +18,7 @@ use tss_reel::controller::{Config, Controller, Health, Input, Phase};
 use tss_sim::history::History;
 use tss_sim::scenario::Scenario;
 
-#[path = "../examples/bench_step/mission.rs"]
-mod mission;
+use tss_reel::recordings::mission;
 
 /// Seconds between recorded samples.
 const EVERY_S: u32 = 5;
@@ -32,7 +31,7 @@ fn root() -> PathBuf {
 }
 
 fn data_path() -> PathBuf {
-    root().join("examples/bench_step/mission_data.rs")
+    root().join("src/recordings/mission/data.rs")
 }
 
 /// The paper mission simulated by `tss-sim`, recorded every `EVERY_S` seconds.

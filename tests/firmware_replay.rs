@@ -1,7 +1,7 @@
 //! The firmware's built-in test input, and the proof that host and target compute the same
 //! commands from it.
 //!
-//! `src/firmware/replay_data.rs` holds the first [`TICKS`] control periods of the paper's
+//! `src/recordings/replay.rs` holds the first [`TICKS`] control periods of the paper's
 //! mission as the reel MCU would sense them (l, α, α̇ rounded to f32, one sample per second),
 //! recorded from `tss-sim`. The firmware (`src/firmware/mission.rs`) replays them through
 //! `tss_reel`'s controller in QEMU, with a sensor dropout injected at
@@ -18,9 +18,7 @@ use std::path::{Path, PathBuf};
 use tss_reel::controller::{Config, Controller, Input};
 use tss_sim::scenario::Scenario;
 
-#[path = "../src/firmware/replay_data.rs"]
-#[allow(dead_code)]
-mod replay_data;
+use tss_reel::recordings::replay as replay_data;
 
 /// Control periods recorded (12 minutes at 1 s: the flash budget of issue 7 holds 48 KiB).
 const TICKS: usize = 720;
@@ -73,7 +71,7 @@ fn generate() -> String {
 
 #[test]
 fn replay_data_is_the_recorded_mission() {
-    let path = root().join("src/firmware/replay_data.rs");
+    let path = root().join("src/recordings/replay.rs");
     let fresh = generate();
     if std::env::var_os("TSS_BLESS").is_some() {
         std::fs::write(&path, &fresh).unwrap();

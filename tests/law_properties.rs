@@ -1,4 +1,4 @@
-//! Properties of the implicit range-rate law (SPEC §5) on random states, in f64.
+//! Properties of the implicit range-rate law (docs/equations.md §5) on random states, in f64.
 //!
 //! - Residual: the command y substituted back into Eqs. 27 + 29 (with α̇_r = p·y + r inside
 //!   δ̇) gives y again.

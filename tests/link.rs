@@ -6,8 +6,8 @@
 
 use proptest::prelude::*;
 use tss_reel::link::{
-    decode, encode, Command, End, Frame, FrameReader, Hello, LinkCounters, LinkError, Message,
-    Report, Sample, DELIMITER, MAX_WIRE_LEN, SAMPLE_MISSING,
+    decode, encode, Command, End, Frame, FrameReader, Gate, Hello, LinkCounters, LinkError,
+    Message, Report, Sample, SampleGate, DELIMITER, MAX_WIRE_LEN, SAMPLE_MISSING, SAMPLE_VALID,
 };
 
 /// Cases per property: the issue asks for at least 100 000 on the decoder. `TSS_LINK_CASES`
@@ -218,5 +218,92 @@ proptest! {
         }
         let ok = read_all(&stream).into_iter().filter(|r| r.is_ok()).count();
         prop_assert!(ok >= valid);
+    }
+}
+
+/// What the plant's injector does to one sample frame (`host-sim/src/pil.rs`).
+#[derive(Clone, Copy, Debug)]
+enum Fault {
+    None,
+    /// Not sent.
+    Drop,
+    /// Sent damaged: the decoder rejects it, the gate never sees it.
+    Corrupt,
+    /// Sent twice.
+    Duplicate,
+    /// Held back and sent just before the next frame (or before `End`).
+    Reorder,
+}
+
+fn fault() -> impl Strategy<Value = Fault> {
+    prop_oneof![
+        Just(Fault::None),
+        Just(Fault::Drop),
+        Just(Fault::Corrupt),
+        Just(Fault::Duplicate),
+        Just(Fault::Reorder),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 10_000, ..config() })]
+
+    /// Issue 16 §4: the end-of-run accounting is exact whatever the loss pattern, lost first
+    /// and last frames included: the gate, fed what the firmware would receive period by
+    /// period and closed by `End`, counts exactly the faults the plant injected.
+    #[test]
+    fn the_gate_counts_exactly_under_any_loss_pattern(
+        faults in proptest::collection::vec(fault(), 0..300),
+    ) {
+        let sample = |tick| Sample {
+            tick,
+            status: SAMPLE_VALID,
+            length_m: 1.0,
+            alpha_rad: 0.0,
+            alpha_rate_radps: 0.0,
+            orbit_rate_radps: 1e-3,
+        };
+        let mut gate = SampleGate::new();
+        let mut c = LinkCounters::default();
+        let mut held: Option<u32> = None;
+        let (mut lost, mut duplicated, mut reordered, mut accepted) = (0u32, 0u32, 0u32, 0u32);
+        for (tick, &f) in (0u32..).zip(&faults) {
+            // Frame number = tick: the plant sends one new frame per period.
+            let mut arrive = |seq: u32| match gate.check(seq, sample(seq), tick, &mut c) {
+                Gate::Accept(s) => {
+                    prop_assert_eq!(s.tick, tick);
+                    accepted += 1;
+                    Ok(())
+                }
+                Gate::Duplicate | Gate::OutOfOrder => Ok(()),
+            };
+            if let Some(late) = held.take() {
+                arrive(late)?;
+            }
+            match f {
+                Fault::None => arrive(tick)?,
+                Fault::Drop | Fault::Corrupt => lost += 1,
+                Fault::Duplicate => {
+                    duplicated += 1;
+                    arrive(tick)?;
+                    arrive(tick)?;
+                }
+                Fault::Reorder => {
+                    reordered += 1;
+                    held = Some(tick);
+                }
+            }
+        }
+        let end_seq = faults.len() as u32;
+        if let Some(late) = held.take() {
+            let awaited = end_seq;
+            prop_assert_eq!(gate.check(late, sample(late), awaited, &mut c), Gate::OutOfOrder);
+        }
+        gate.close(end_seq, &mut c);
+        prop_assert_eq!(c.seq_gaps, lost);
+        prop_assert_eq!(c.duplicates, duplicated);
+        prop_assert_eq!(c.out_of_order, reordered);
+        prop_assert_eq!(c.frames_ok, accepted);
+        prop_assert_eq!(accepted + lost + reordered, end_seq);
     }
 }

@@ -1,39 +1,27 @@
 //! On-target tests: the library's arithmetic run on the Cortex-M4F itself (in f32, with the
 //! FPU and libm as flown), in QEMU, by the defmt-test harness.
 //!
-//! Run with `cargo tt` (`cargo test --target thumbv7em-none-eabihf --test on_target`); the runner
-//! `scripts/qemu-run` boots the test ELF and decodes its log. Each `#[test]` is one function in the
-//! `tests` module below; a failed `defmt::assert!` panics, panic-probe turns that into a
-//! HardFault, and the HardFault handler (the firmware's own, `src/firmware/exit.rs`) exits QEMU
-//! with a failure, so a failing test fails the run at once.
+//! Run with `cargo tt` (`cargo test --target thumbv7em-none-eabihf --features firmware --test
+//! on_target`); the runner `scripts/qemu-run` boots the test ELF and decodes its log. Each
+//! `#[test]` is one function in the `tests` module below; a failed `defmt::assert!` panics,
+//! panic-probe turns that into a HardFault, and the HardFault handler (the firmware's own,
+//! `tss_reel::firmware::exit`) exits QEMU with a failure, so a failing test fails the run at once.
 //!
 //! To add a test: add a `#[test] fn name() { … }` to `mod tests`, using `tss_reel`'s public API
 //! and `defmt::assert!`. Tolerances are for f32 arithmetic.
 //!
-//! On the host this file compiles to an empty program (the harness is `false` in Cargo.toml), so
-//! `cargo test --workspace` builds and runs it as a no-op; the host's own tests of the same
-//! functions (in f64) are the library's unit tests.
-#![cfg_attr(target_os = "none", no_std, no_main)]
+//! It needs the `firmware` feature (`required-features` in Cargo.toml; `cargo tt` passes it) and
+//! the bare-metal target; the host's own tests of the same functions (in f64) are the library's
+//! unit tests.
+#![no_std]
+#![no_main]
 #![deny(unsafe_code)]
 
-/// Host stub: the tests in this file run only on the target (see the crate docs).
-#[cfg(not(target_os = "none"))]
-fn main() {}
-
-// The global logger and the panic handler, as in the firmware.
-#[cfg(target_os = "none")]
-use defmt_semihosting as _;
-#[cfg(target_os = "none")]
-use panic_probe as _;
-
-/// The firmware's exits and fault handlers (HardFault => failing exit), shared file.
-#[cfg(target_os = "none")]
-#[allow(dead_code)] // `success` is the firmware's; defmt-test has its own success exit.
-#[path = "../src/firmware/exit.rs"]
-mod exit;
+// The firmware's runtime comes with `tss_reel` and its `firmware` feature, as in the firmware:
+// the global logger (defmt over semihosting), the panic handler (panic-probe), and the
+// HardFault handler that exits QEMU with a failure (`tss_reel::firmware::exit`).
 
 /// Constants and helpers of the tests (defmt-test allows only test functions in `mod tests`).
-#[cfg(target_os = "none")]
 mod support {
     use tss_reel::mass::MassModel;
 
@@ -54,7 +42,6 @@ mod support {
     }
 }
 
-#[cfg(target_os = "none")]
 #[defmt_test::tests]
 mod tests {
     use super::support::{close_rel, thin_tether, R_PAPER_M};
@@ -193,7 +180,7 @@ mod tests {
 
     #[test]
     fn implicit_law_residual_is_zero_in_f32() {
-        // Substituting the command back into Eqs. 27 + 29 gives it back (SPEC §5).
+        // Substituting the command back into Eqs. 27 + 29 gives it back (docs/equations.md §5).
         use tss_reel::law::{solve, Blend, Gains, LawInput};
         let x = LawInput {
             length_m: 15_000.0_f32,

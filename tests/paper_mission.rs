@@ -1,4 +1,4 @@
-//! Closed-loop tests of the paper's Section-6 mission (SPEC §7): the flight controller core
+//! Closed-loop tests of the paper's Section-6 mission (docs/equations.md §7): the flight controller core
 //! (f32) flying the f64 plant of Eq. 5 in `tss-sim`.
 //!
 //! Each mission is simulated once per test binary and shared by the tests below.
@@ -61,7 +61,7 @@ fn stage1_table1_lengths_within_6_cm_of_the_paper() {
 
 #[test]
 fn stage2_table1_settles_on_2_km_below_the_papers_offset() {
-    // SPEC §7: the paper's stage-2 column settles about 0.11 m above 2000 m; an exact
+    // docs/equations.md §7: the paper's stage-2 column settles about 0.11 m above 2000 m; an exact
     // implementation settles at 2000 m. Ours is below the paper at every instant, above 2 km,
     // and decreasing, like the paper's column.
     let h = paper();
@@ -146,7 +146,7 @@ fn alpha_follows_minus_45_degrees_in_early_deployment() {
 
 #[test]
 fn milestones_match_the_papers_description() {
-    // SPEC §7: 10 km near 2.5 h, 30 km near 3.3 h with an overshoot.
+    // docs/equations.md §7: 10 km near 2.5 h, 30 km near 3.3 h with an overshoot.
     let h = paper();
     let first =
         |pred: &dyn Fn(&Sample) -> bool| h.samples.iter().find(|s| pred(s)).map(|s| s.t_s / 3600.0);
@@ -193,7 +193,7 @@ fn phases_occur_in_order_without_faults_or_saturation() {
 
 #[test]
 fn massive_tether_mission_is_well_behaved() {
-    // ρ = 1e-3 kg/m: 40 kg of tether at 40 km, μ1, μ3 ≠ 0 and μ2 < 1 (SPEC §1).
+    // ρ = 1e-3 kg/m: 40 kg of tether at 40 km, μ1, μ3 ≠ 0 and μ2 < 1 (docs/equations.md §1).
     let h = massive_tether();
     let keep = between(h, 7.0, 8.0)
         .map(|s| (s.length_m - 30_000.0).abs())

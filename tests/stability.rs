@@ -1,4 +1,4 @@
-//! Host tests of the equilibrium and stability analysis (Eqs. 6–19, 28; SPEC §3–4).
+//! Host tests of the equilibrium and stability analysis (Eqs. 6–19, 28; docs/equations.md §3–4).
 //!
 //! Theorem 1 and Figs. 2–3, the paper's three conclusions of §4, the closed-form roots against
 //! nalgebra's eigenvalues of the full Jacobian, and the closed loop of the paper's gains.

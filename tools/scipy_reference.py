@@ -101,7 +101,7 @@ def mu3(sc, l):
 
 # --- reference schedules (src/schedule.rs) --------------------------------------------------
 def band(s, l):
-    """α_r, ∂α_r/∂l of a BandSchedule (quintic Hermite transition, SPEC §6)."""
+    """α_r, ∂α_r/∂l of a BandSchedule (quintic Hermite transition, docs/equations.md §6)."""
     lo, a_lo, k_lo, hi, a_hi, k_hi = s
     if l <= lo:
         return a_lo + k_lo * (l - lo), k_lo
@@ -169,7 +169,7 @@ class Control:
                      math.exp(-c * tau), ld0)
         if y is None:
             # A singular point (n + δ̇ → 0, which the paper's run nears in its first minutes:
-            # SPEC §5): the controller would coast on its last command. Only the solver's trial
+            # docs/equations.md §5): the controller would coast on its last command. Only the solver's trial
             # stages get here; its error control rejects them.
             self.singular += 1
             return self.last
@@ -216,7 +216,7 @@ def run_continuous(sc, rtol, method):
     out, nfev = [], 0
     for stage2, (t0, t1) in ((False, (0.0, sc.t2)), (True, (sc.t2, sc.duration))):
         if stage2:
-            # The blend restarts from the command in force just before stage 2 (SPEC §7).
+            # The blend restarts from the command in force just before stage 2 (docs/equations.md §7).
             ctl.stage2_ld0 = ctl.rate(t0, x0, False)
         teval = sorted({t for t in probes if t0 <= t <= t1} | {t1})
         sol = solve_ivp(lambda t, x: derivative(sc, x, ctl.rate(t, x, stage2)), (t0, t1), x0,

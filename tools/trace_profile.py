@@ -15,8 +15,9 @@ with everything LLVM inlined into `Controller::step` sorted back into the paper'
 
 --mission-tick N profiles step N of the whole 20-h paper mission instead: the subject is
 examples/trace_step.rs (one `Controller::step` a tick, built with the flight profile:
-`cargo build --profile firmware --target thumbv7em-none-eabihf --example trace_step`), and the
-instructions counted are those from the N-th entry into `Controller::advance` to the return to
+`cargo build --profile firmware --target thumbv7em-none-eabihf --features firmware
+--example trace_step`), and the
+instructions counted are those from the N-th entry into `Controller::run` to the return to
 the caller. The trace is streamed through a pipe, not stored (a late step is some 4·10^7 lines in).
 
 Defaults: the flight firmware (target/thumbv7em-none-eabihf/firmware/tss-reel, build it with
@@ -75,7 +76,7 @@ def main():
         if a.elf == ap.get_default("elf"):
             a.elf = "target/thumbv7em-none-eabihf/firmware/examples/trace_step"
         pcs = mission_step_pcs(a.elf, a.mission_tick)
-        what = f"mission step {a.mission_tick}: {len(pcs)} instructions, Controller::advance entry to return"
+        what = f"mission step {a.mission_tick}: {len(pcs)} instructions, Controller::run entry to return"
     else:
         pcs = firmware_tick_pcs(a.elf, a.tick)
         what = f"tick {a.tick}: {len(pcs)} instructions, SysTick entry to SysTick entry"
@@ -104,14 +105,14 @@ def trace_pcs(lines):
 
 
 def mission_step_pcs(elf, n):
-    """The PCs of the n-th call of Controller::advance (n counts from 0), read from a pipe:
+    """The PCs of the n-th call of Controller::run (n counts from 0), read from a pipe:
     from its entry to the return to the caller (the instruction after the caller's `bl`)."""
     nm = subprocess.run(["llvm-nm", "--defined-only", elf], capture_output=True,
                         text=True, check=True).stdout
     entries = [int(l.split()[0], 16) & ~1 for l in nm.splitlines()
-               if "Controller" in l and "advance" in l]
+               if "Controller" in l and "3run17h" in l]  # Controller::run, legacy mangling
     if len(entries) != 1:
-        sys.exit(f"trace_profile: expected one Controller::advance in {elf}, found {len(entries)}")
+        sys.exit(f"trace_profile: expected one Controller::run in {elf}, found {len(entries)}")
     entry = entries[0]
     with tempfile.TemporaryDirectory() as tmp:
         fifo = os.path.join(tmp, "trace.fifo")

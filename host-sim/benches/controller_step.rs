@@ -3,7 +3,7 @@
 //! - `controller_step/deploy_band`: one nominal step in the stage-1 transition band (the
 //!   mission at t = 3000 s), on a fresh copy of the controller's state each time;
 //! - `controller_step/mission_72001_steps`: the whole 20-hour paper mission, replayed at 1 s
-//!   from the benchmarks' recording (`examples/bench_step/mission.rs`); divide by 72 001 for
+//!   from the benchmarks' recording (`tss_reel::recordings::mission`); divide by 72 001 for
 //!   the mean step.
 //!
 //! `cargo bench -p tss-sim --bench controller_step`. Figures only, no assertions.
@@ -12,9 +12,7 @@ use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughpu
 use std::hint::black_box;
 use tss_reel::controller::{Config, Controller, Input};
 
-#[path = "../../examples/bench_step/mission.rs"]
-#[allow(dead_code)]
-mod mission;
+use tss_reel::recordings::mission;
 
 fn input(tick: u32) -> Input<f32> {
     let s = mission::sample(tick).expect("tick within the mission");

@@ -1,4 +1,4 @@
-//! One RK4 step of the plant (Eq. 5 in f64, `tss_sim::plant::Plant::rk4_step`), the paper's
+//! One RK4 step of the plant (Eq. 5 in f64, `tss_sim::plant::RigidModel::rk4_step`), the paper's
 //! orbit and masses, 1 s step at the mission's initial state with the reel at 0.1 m/s.
 //!
 //! `cargo bench -p tss-sim --bench plant_rk4`. Figures only, no assertions.

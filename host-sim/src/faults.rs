@@ -13,10 +13,10 @@
 
 use std::fmt::Write as _;
 
-use tss_reel::controller::{Fault, Flags, Health, Output};
+use tss_reel::controller::{Envelope, Fault, Flags, Health, Output};
 use tss_reel::Real;
 
-use crate::scenario::{CorruptSection, EnvelopeSection, Scenario, SensorName, SensorSection};
+use crate::reel::ReelDrive;
 
 // ---- a small deterministic generator ---------------------------------------------------------
 
@@ -75,6 +75,124 @@ impl Pcg32 {
     }
 }
 
+// ---- what is injected: the fault model's parameters -------------------------------------------
+
+/// One sensor's errors, in the sensor's own unit (m, rad, rad/s), applied in the order bias,
+/// noise, quantisation, then a stuck window freezes the reading.
+/// The default is a perfect sensor.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SensorErrors {
+    /// Standard deviation of white Gaussian noise added every sample (0 = none).
+    pub noise_std: f64,
+    /// Constant offset added to every sample.
+    pub bias: f64,
+    /// Quantisation step: the reading is rounded to a multiple of it (0 = none).
+    pub quantum: f64,
+    /// While in this window the sensor repeats the reading it gave at its start (`None`:
+    /// never stuck).
+    pub stuck: Option<Window>,
+}
+
+impl SensorErrors {
+    /// `true` if the sensor reads the truth.
+    pub fn is_perfect(&self) -> bool {
+        self.noise_std == 0.0 && self.bias == 0.0 && self.quantum == 0.0 && self.stuck.is_none()
+    }
+}
+
+/// A quantity the controller reads, as a corrupted reading can hit it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SensedQuantity {
+    /// The tether length (encoder), m.
+    Length,
+    /// α, rad.
+    Alpha,
+    /// α̇, rad/s.
+    AlphaRate,
+    /// The orbit rate θ̇, rad/s.
+    OrbitRate,
+}
+
+impl SensedQuantity {
+    /// Its name in messages (as in scenario files).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Length => "length",
+            Self::Alpha => "alpha",
+            Self::AlphaRate => "alpha_rate",
+            Self::OrbitRate => "orbit_rate",
+        }
+    }
+}
+
+/// A time window [from_s, until_s) on the control ticks, s (until inf = to the end of the run).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Window {
+    /// Start, s.
+    pub from_s: f64,
+    /// End (excluded), s.
+    pub until_s: f64,
+}
+
+impl Window {
+    /// `t_s` is inside the window.
+    pub fn contains(&self, t_s: f64) -> bool {
+        t_s >= self.from_s && t_s < self.until_s
+    }
+}
+
+/// A reading replaced by a fixed value (NaN, inf, anything) during a window.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Corruption {
+    /// Which quantity.
+    pub sensor: SensedQuantity,
+    /// When.
+    pub window: Window,
+    /// The reading, in the quantity's unit.
+    pub value: f64,
+}
+
+/// A one-tick error of the length encoder.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Glitch {
+    /// When, s (the tick at or after it).
+    pub at_s: f64,
+    /// Size of the error, m.
+    pub size_m: f64,
+}
+
+/// Everything injected between the plant and the controller: the parameters of an
+/// [`Injector`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct InjectionPlan {
+    /// Seed of the noise generators (one stream per sensor).
+    pub seed: u64,
+    /// The length encoder's errors.
+    pub length: SensorErrors,
+    /// The α sensor's errors.
+    pub alpha: SensorErrors,
+    /// The α̇ sensor's errors.
+    pub alpha_rate: SensorErrors,
+    /// Windows without a sample (the controller's `step_missing`).
+    pub dropout: Vec<Window>,
+    /// Corrupted readings.
+    pub corrupt: Vec<Corruption>,
+    /// Length-encoder glitches.
+    pub length_glitch: Vec<Glitch>,
+}
+
+impl InjectionPlan {
+    /// `true` if nothing is injected: the controller reads the truth (rounded to its type).
+    pub fn is_transparent(&self) -> bool {
+        self.length.is_perfect()
+            && self.alpha.is_perfect()
+            && self.alpha_rate.is_perfect()
+            && self.dropout.is_empty()
+            && self.corrupt.is_empty()
+            && self.length_glitch.is_empty()
+    }
+}
+
 // ---- sensors ----------------------------------------------------------------------------------
 
 /// The plant's true values of what the controller senses, in f64.
@@ -93,13 +211,13 @@ pub struct Truth {
 /// One sensor: bias, noise, quantisation, stuck window.
 #[derive(Clone, Debug)]
 struct Channel {
-    cfg: SensorSection,
+    cfg: SensorErrors,
     rng: Pcg32,
     held: Option<f64>,
 }
 
 impl Channel {
-    fn new(cfg: &SensorSection, seed: u64, stream: u64) -> Self {
+    fn new(cfg: &SensorErrors, seed: u64, stream: u64) -> Self {
         Self {
             cfg: cfg.clone(),
             rng: Pcg32::new(seed, stream),
@@ -125,7 +243,7 @@ impl Channel {
         if c.quantum > 0.0 {
             v = (v / c.quantum).round() * c.quantum;
         }
-        if t_s >= c.stuck_from_s && t_s < c.stuck_until_s {
+        if c.stuck.is_some_and(|w| w.contains(t_s)) {
             *self.held.get_or_insert(v)
         } else {
             self.held = None;
@@ -143,59 +261,34 @@ pub enum Sensed {
     Missing,
 }
 
-/// Applies the scenario's `[sensors]` and `[faults]` to the plant's truth, tick by tick.
+/// Applies an [`InjectionPlan`] (a scenario's `[sensors]` and `[faults]`) to the plant's truth,
+/// tick by tick.
 #[derive(Clone, Debug)]
 pub struct Injector {
     length: Channel,
     alpha: Channel,
     alpha_rate: Channel,
-    dropout: Vec<(f64, f64)>,
-    corrupt: Vec<CorruptSection>,
+    dropout: Vec<Window>,
+    corrupt: Vec<Corruption>,
     /// (tick, size) of each length glitch.
     glitches: Vec<(u32, f64)>,
 }
 
 impl Injector {
-    /// The injector of `sc` (control period `sc.controller.period_s`).
-    pub fn new(sc: &Scenario) -> Self {
-        let s = &sc.sensors;
-        let period = sc.controller.period_s;
+    /// The injector of `plan` on control period `period_s`.
+    pub fn new(plan: &InjectionPlan, period_s: f64) -> Self {
         Self {
-            length: Channel::new(&s.length, s.seed, 1),
-            alpha: Channel::new(&s.alpha, s.seed, 2),
-            alpha_rate: Channel::new(&s.alpha_rate, s.seed, 3),
-            dropout: sc
-                .faults
-                .dropout
-                .iter()
-                .map(|w| (w.from_s, w.until_s))
-                .collect(),
-            corrupt: sc.faults.corrupt.clone(),
-            glitches: sc
-                .faults
+            length: Channel::new(&plan.length, plan.seed, 1),
+            alpha: Channel::new(&plan.alpha, plan.seed, 2),
+            alpha_rate: Channel::new(&plan.alpha_rate, plan.seed, 3),
+            dropout: plan.dropout.clone(),
+            corrupt: plan.corrupt.clone(),
+            glitches: plan
                 .length_glitch
                 .iter()
-                .map(|g| (first_tick_at(g.at_s, period), g.size_m))
+                .map(|g| (first_tick_at(g.at_s, period_s), g.size_m))
                 .collect(),
         }
-    }
-
-    /// `true` if nothing is injected: the controller reads the truth (rounded to its type).
-    pub fn is_transparent(sc: &Scenario) -> bool {
-        let quiet = |c: &SensorSection| {
-            c.noise_std == 0.0
-                && c.bias == 0.0
-                && c.quantum == 0.0
-                && c.stuck_from_s == f64::INFINITY
-        };
-        let s = &sc.sensors;
-        let f = &sc.faults;
-        quiet(&s.length)
-            && quiet(&s.alpha)
-            && quiet(&s.alpha_rate)
-            && f.dropout.is_empty()
-            && f.corrupt.is_empty()
-            && f.length_glitch.is_empty()
     }
 
     /// What the controller reads at `tick` (mission time `t_s`).
@@ -206,7 +299,7 @@ impl Injector {
             alpha_rate_radps: self.alpha_rate.read(truth.alpha_rate_radps, t_s),
             orbit_rate_radps: truth.orbit_rate_radps,
         };
-        if self.dropout.iter().any(|&(a, b)| t_s >= a && t_s < b) {
+        if self.dropout.iter().any(|w| w.contains(t_s)) {
             return Sensed::Missing;
         }
         for &(at, size) in &self.glitches {
@@ -215,12 +308,12 @@ impl Injector {
             }
         }
         for c in &self.corrupt {
-            if t_s >= c.from_s && t_s < c.until_s {
+            if c.window.contains(t_s) {
                 match c.sensor {
-                    SensorName::Length => r.length_m = c.value,
-                    SensorName::Alpha => r.alpha_rad = c.value,
-                    SensorName::AlphaRate => r.alpha_rate_radps = c.value,
-                    SensorName::OrbitRate => r.orbit_rate_radps = c.value,
+                    SensedQuantity::Length => r.length_m = c.value,
+                    SensedQuantity::Alpha => r.alpha_rad = c.value,
+                    SensedQuantity::AlphaRate => r.alpha_rate_radps = c.value,
+                    SensedQuantity::OrbitRate => r.orbit_rate_radps = c.value,
                 }
             }
         }
@@ -300,6 +393,8 @@ pub struct FlagTicks {
     pub health_changed: u32,
     /// `Flags::NO_EQUILIBRIUM`.
     pub no_equilibrium: u32,
+    /// `Flags::NO_PROGRESS`.
+    pub no_progress: u32,
 }
 
 impl FlagTicks {
@@ -317,10 +412,11 @@ impl FlagTicks {
         bump(Flags::SLEWING, &mut self.slewing);
         bump(Flags::HEALTH_CHANGED, &mut self.health_changed);
         bump(Flags::NO_EQUILIBRIUM, &mut self.no_equilibrium);
+        bump(Flags::NO_PROGRESS, &mut self.no_progress);
     }
 
     /// (name, ticks) of every flag, in bit order.
-    pub fn named(&self) -> [(&'static str, u32); 8] {
+    pub fn named(&self) -> [(&'static str, u32); 9] {
         [
             ("rate-saturated", self.rate_saturated),
             ("accel-saturated", self.accel_saturated),
@@ -330,6 +426,7 @@ impl FlagTicks {
             ("slewing", self.slewing),
             ("health-changed", self.health_changed),
             ("no-equilibrium", self.no_equilibrium),
+            ("no-progress", self.no_progress),
         ]
     }
 }
@@ -450,8 +547,8 @@ pub struct SummaryBuilder {
 }
 
 impl SummaryBuilder {
-    /// A builder for a run with control period `period_s` and the scenario's envelope.
-    pub fn new(period_s: f64, envelope: &EnvelopeSection) -> Self {
+    /// A builder for a run with control period `period_s` and the controller's envelope.
+    pub fn new(period_s: f64, envelope: &Envelope<f64>) -> Self {
         Self {
             s: FaultSummary {
                 period_s,
@@ -620,13 +717,28 @@ fn window(from_s: f64, until_s: f64) -> String {
     }
 }
 
-/// What `sc` injects, one line per item (empty: nothing).
-pub fn injected_faults(sc: &Scenario) -> Vec<String> {
+/// What a fault summary describes besides its counts: the run's name, what was injected, the
+/// reel drive and the controller's envelope (a scenario converts into it).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FaultSetup {
+    /// The scenario's name.
+    pub name: String,
+    /// The sensor errors and faults injected.
+    pub injection: InjectionPlan,
+    /// The reel drive.
+    pub reel: ReelDrive,
+    /// The controller's envelope.
+    pub envelope: Envelope<f64>,
+}
+
+/// What `setup` injects, one line per item (empty: nothing).
+pub fn injected_faults(setup: &FaultSetup) -> Vec<String> {
     let mut v = Vec::new();
+    let plan = &setup.injection;
     for (name, c) in [
-        ("length (m)", &sc.sensors.length),
-        ("alpha (rad)", &sc.sensors.alpha),
-        ("alpha_rate (rad/s)", &sc.sensors.alpha_rate),
+        ("length (m)", &plan.length),
+        ("alpha (rad)", &plan.alpha),
+        ("alpha_rate (rad/s)", &plan.alpha_rate),
     ] {
         let mut parts = Vec::new();
         if c.noise_std > 0.0 {
@@ -638,34 +750,34 @@ pub fn injected_faults(sc: &Scenario) -> Vec<String> {
         if c.quantum > 0.0 {
             parts.push(format!("quantum {}", c.quantum));
         }
-        if c.stuck_from_s != f64::INFINITY {
-            parts.push(format!("stuck {}", window(c.stuck_from_s, c.stuck_until_s)));
+        if let Some(w) = c.stuck {
+            parts.push(format!("stuck {}", window(w.from_s, w.until_s)));
         }
         if !parts.is_empty() {
             v.push(format!("sensor {name}: {}", parts.join(", ")));
         }
     }
     if v.iter().any(|l| l.contains("noise")) {
-        v.push(format!("noise seed {}", sc.sensors.seed));
+        v.push(format!("noise seed {}", plan.seed));
     }
-    for w in &sc.faults.dropout {
+    for w in &plan.dropout {
         v.push(format!(
             "dropout (no sample) {}",
             window(w.from_s, w.until_s)
         ));
     }
-    for c in &sc.faults.corrupt {
+    for c in &plan.corrupt {
         v.push(format!(
             "{} reads {} {}",
-            c.sensor.as_str(),
+            c.sensor.name(),
             c.value,
-            window(c.from_s, c.until_s)
+            window(c.window.from_s, c.window.until_s)
         ));
     }
-    for g in &sc.faults.length_glitch {
+    for g in &plan.length_glitch {
         v.push(format!("length glitch {} m at {} s", g.size_m, g.at_s));
     }
-    let r = &sc.reel;
+    let r = &setup.reel;
     if r.lag_s > 0.0 || r.max_rate_mps < f64::INFINITY || r.max_accel_mps2 < f64::INFINITY {
         v.push(format!(
             "reel drive: lag {} s, rate limit {} m/s, acceleration limit {} m/s²",
@@ -675,13 +787,18 @@ pub fn injected_faults(sc: &Scenario) -> Vec<String> {
     v
 }
 
-/// The fault summary of a run of `sc` as text (printed by `tss-sim run`, written to
-/// `faults.txt`).
-pub fn render_fault_summary(sc: &Scenario, s: &FaultSummary) -> String {
+/// The fault summary of a run as text (printed by `tss-sim run`, written to `faults.txt`);
+/// `setup` is typically the run's `&Scenario`.
+pub fn render_fault_summary(setup: impl Into<FaultSetup>, s: &FaultSummary) -> String {
+    let setup = setup.into();
     let mut o = String::new();
     let dt = s.period_s;
-    let _ = writeln!(o, "Faults, health and envelope of scenario `{}`", sc.name);
-    let injected = injected_faults(sc);
+    let _ = writeln!(
+        o,
+        "Faults, health and envelope of scenario `{}`",
+        setup.name
+    );
+    let injected = injected_faults(&setup);
     if injected.is_empty() {
         let _ = writeln!(o, "  injected: nothing (perfect sensors, ideal reel)");
     } else {
@@ -766,8 +883,8 @@ pub fn render_fault_summary(sc: &Scenario, s: &FaultSummary) -> String {
         "  tether: {:.3} … {:.3} m; outside [{}, {}] m for {:.0} s (by at most {:.4} m)",
         s.length_range_m.0,
         s.length_range_m.1,
-        sc.envelope.min_length_m,
-        sc.envelope.max_length_m,
+        setup.envelope.min_length_m,
+        setup.envelope.max_length_m,
         s.outside_envelope_s,
         s.max_excursion_m
     );
@@ -776,9 +893,9 @@ pub fn render_fault_summary(sc: &Scenario, s: &FaultSummary) -> String {
         "  commands: max |l̇| = {:.4} m/s (limit {}), max |Δl̇|/Δt = {:.4} m/s² (limit {}); \
          beyond the limits: rate {} ticks, acceleration {} ticks",
         s.max_rate_cmd_mps,
-        sc.envelope.max_rate_mps,
+        setup.envelope.max_rate_mps,
         s.max_accel_cmd_mps2,
-        sc.envelope.max_accel_mps2,
+        setup.envelope.max_accel_mps2,
         s.rate_exceeded_ticks,
         s.accel_exceeded_ticks
     );
@@ -842,18 +959,20 @@ mod tests {
         assert_ne!(xs[0], c.normal());
     }
 
-    fn channel(cfg: SensorSection) -> Channel {
+    fn channel(cfg: SensorErrors) -> Channel {
         Channel::new(&cfg, 1, 1)
     }
 
     #[test]
     fn bias_quantum_and_stuck_window() {
-        let mut c = channel(SensorSection {
+        let mut c = channel(SensorErrors {
             bias: 0.3,
             quantum: 0.25,
-            stuck_from_s: 2.0,
-            stuck_until_s: 4.0,
-            ..SensorSection::default()
+            stuck: Some(Window {
+                from_s: 2.0,
+                until_s: 4.0,
+            }),
+            ..SensorErrors::default()
         });
         assert_eq!(c.read(1.0, 0.0), 1.25); // 1.3 → 1.25
         assert_eq!(c.read(1.2, 1.0), 1.5);
@@ -864,9 +983,9 @@ mod tests {
 
     #[test]
     fn noise_has_the_stated_deviation() {
-        let mut c = channel(SensorSection {
+        let mut c = channel(SensorErrors {
             noise_std: 0.01,
-            ..SensorSection::default()
+            ..SensorErrors::default()
         });
         let n = 20_000;
         let rms = ((0..n)

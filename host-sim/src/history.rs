@@ -3,6 +3,8 @@
 //! This is the contract between the closed-loop simulation (`sim`) and everything that reports
 //! on it (CSV, figures, Table 1, summary).
 
+use tss_reel::controller::Flags;
+
 /// Mission phase as reported by the controller, in the order they occur.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum PhaseLabel {
@@ -63,7 +65,8 @@ pub struct Sample {
     pub blend_weight: f64,
     /// Mission phase.
     pub phase: PhaseLabel,
-    /// Controller status flags (raw bits of `tss_reel` output flags).
+    /// Controller status flags: the bits of `tss_reel::controller::Flags` ([`FLAG_NAMES`]
+    /// names them; [`flag_names`] writes them as text).
     pub flags: u32,
 }
 
@@ -78,4 +81,63 @@ pub struct History {
     /// Faults, health, tension and envelope over every control tick of the run (see
     /// `faults::FaultSummary`; all zero for a history not made by `sim::run`).
     pub faults: crate::faults::FaultSummary,
+    /// The elastic plant's extra quantities, one per sample (empty for the rigid plant).
+    pub elastic: Vec<crate::plant::ElasticObservation>,
+    /// The tether's shape every `plant.shape_interval_s` and at the end (elastic plant):
+    /// (t_s, node positions relative to the main satellite in the orbit frame e_r, e_θ, e_h, m).
+    pub shapes: Vec<(f64, Vec<[f64; 3]>)>,
+}
+
+/// The controller's flag bits (`tss_reel::controller::Flags`, the `flags` column of
+/// `history.csv`) and their names, in bit order.
+pub const FLAG_NAMES: [(u32, &str); 9] = [
+    (Flags::RATE_SATURATED, "rate-saturated"),
+    (Flags::ACCEL_SATURATED, "accel-saturated"),
+    (Flags::LENGTH_LIMITED, "length-limited"),
+    (Flags::SAFE_ACTION, "safe-action"),
+    (Flags::BLEND_RESTART, "blend-restart"),
+    (Flags::SLEWING, "slewing"),
+    (Flags::HEALTH_CHANGED, "health-changed"),
+    (Flags::NO_EQUILIBRIUM, "no-equilibrium"),
+    (Flags::NO_PROGRESS, "no-progress"),
+];
+
+/// The names of the bits set in `flags`, joined by `|` (e.g. `slewing|no-equilibrium`;
+/// `none` for 0; an unknown bit as its hexadecimal value).
+pub fn flag_names(flags: u32) -> String {
+    if flags == 0 {
+        return "none".to_string();
+    }
+    let mut names: Vec<String> = FLAG_NAMES
+        .iter()
+        .filter(|(bit, _)| flags & bit != 0)
+        .map(|(_, name)| (*name).to_string())
+        .collect();
+    let known = FLAG_NAMES.iter().fold(0, |m, (bit, _)| m | bit);
+    if flags & !known != 0 {
+        names.push(format!("{:#x}", flags & !known));
+    }
+    names.join("|")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_flag_has_one_bit_and_a_name() {
+        let mut all = 0;
+        for (bit, name) in FLAG_NAMES {
+            assert_eq!(bit.count_ones(), 1, "{name}");
+            assert_eq!(all & bit, 0, "{name} shares a bit");
+            all |= bit;
+            assert_eq!(flag_names(bit), name);
+        }
+        assert_eq!(flag_names(0), "none");
+        assert_eq!(
+            flag_names(Flags::SLEWING | Flags::NO_EQUILIBRIUM),
+            "slewing|no-equilibrium"
+        );
+        assert_eq!(flag_names(1 << 31), "0x80000000");
+    }
 }

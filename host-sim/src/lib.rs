@@ -2,6 +2,7 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod elastic;
 pub mod faults;
 pub mod history;
 pub mod montecarlo;
@@ -15,3 +16,4 @@ pub mod run_cmd;
 pub mod scenario;
 pub mod sim;
 pub mod table1;
+pub mod usage;

@@ -5,8 +5,8 @@
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
-use tss_sim::{analysis, montecarlo, run_cmd};
+use clap::{CommandFactory, Parser, Subcommand};
+use tss_sim::{analysis, montecarlo, run_cmd, scenario, usage};
 
 /// Exit code for usage errors (as clap uses for bad arguments).
 const EXIT_USAGE: u8 = 2;
@@ -20,6 +20,10 @@ const EXIT_FAILURE: u8 = 1;
     about = "Desktop simulator of the tss-reel controller (He, Liang & Xu 2011)"
 )]
 struct Cli {
+    /// Print nothing on stdout and draw no progress bar (errors still go to stderr; the files
+    /// are written as usual).
+    #[arg(long, short, global = true)]
+    quiet: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -38,22 +42,75 @@ enum Command {
     Montecarlo(montecarlo::MonteCarloArgs),
     /// Combine the output directories of `montecarlo --shard K/N` into the whole campaign's.
     Merge(montecarlo::MergeArgs),
+    /// Print a shell completion script, e.g. `tss-sim completions bash > tss-sim.bash`.
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Scenario files: `scenario keys` lists every key with its unit, default and rules.
+    #[command(subcommand)]
+    Scenario(ScenarioCommand),
+}
+
+#[derive(Subcommand, Debug)]
+enum ScenarioCommand {
+    /// Every scenario key with its type, unit, default and the rules validation enforces (read
+    /// from the schema and from validation itself).
+    Keys {
+        /// `text` (a key per line, its rules indented) or `tsv` (one line per key).
+        #[arg(long, value_enum, default_value_t = KeysFormat::Text)]
+        format: KeysFormat,
+    },
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum KeysFormat {
+    Text,
+    Tsv,
+}
+
+fn scenario_command(command: &ScenarioCommand) -> anyhow::Result<()> {
+    match command {
+        ScenarioCommand::Keys { format } => {
+            let keys = scenario::keys::keys();
+            print!(
+                "{}",
+                match format {
+                    KeysFormat::Text => scenario::keys::render_text(&keys),
+                    KeysFormat::Tsv => scenario::keys::render_tsv(&keys),
+                }
+            );
+            Ok(())
+        }
+    }
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    usage::set_quiet(cli.quiet);
     let result = match cli.command {
         Command::Run(args) => run_cmd::run(args),
         Command::Extent(args) => analysis::run_extent(&args),
         Command::Stability(args) => analysis::run_stability(&args),
         Command::Montecarlo(args) => montecarlo::montecarlo(&args),
         Command::Merge(args) => montecarlo::merge(&args),
+        Command::Completions { shell } => {
+            clap_complete::generate(
+                shell,
+                &mut Cli::command(),
+                "tss-sim",
+                &mut std::io::stdout(),
+            );
+            Ok(())
+        }
+        Command::Scenario(command) => scenario_command(&command),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
             eprintln!("error: {err:#}");
-            if run_cmd::is_usage_error(&err) || analysis::is_usage_error(&err) {
+            if usage::is_usage_error(&err) || analysis::is_usage_error(&err) {
                 ExitCode::from(EXIT_USAGE)
             } else {
                 ExitCode::from(EXIT_FAILURE)

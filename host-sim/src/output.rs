@@ -1,13 +1,251 @@
-//! `history.csv`: one row per [`Sample`], every number at full (round-trip) precision.
+//! Every file a command writes goes through this module.
 //!
+//! **Output directories** ([`OutputSet`]). A command checks its output directory before any
+//! work (it is created and probed for writing: an unusable one is a [`UsageError`], exit code
+//! 2), writes each file under a temporary name next to its final one (`history.partial.csv`
+//! for `history.csv`), and renames them all into place only when the whole set is written. A
+//! failed run leaves the directory as it was (what it created is removed again), except for a
+//! log that explains the failure (PIL's `firmware.partial.log`). Each command owns a fixed set
+//! of file names: on success, those of its names that this run did not write (say `pil.txt`
+//! after a run without `--pil`, or the figures when they could not be drawn) are removed, so
+//! that no earlier run's file sits next to this run's results. Other files are left alone.
+//!
+//! **`history.csv`**: one row per [`Sample`], every number at full (round-trip) precision.
 //! The first ten columns are fixed (scripts and the paper's figures rely on them); the extra
 //! columns follow in [`HISTORY_EXTRA_COLUMNS`] order. Numbers are written with Rust's `{}`
 //! formatting of `f64`, the shortest text that parses back to the same bits
 //! (`NaN`, `inf` and `-inf` for non-finite values).
 
-use std::io::{self, BufRead, Write};
+use std::fs::File;
+use std::io::{self, BufRead, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
 
 use crate::history::{PhaseLabel, Sample};
+use crate::usage::UsageError;
+
+/// Checks, without creating anything, that `dir` is a directory or can be created as one
+/// (`flag` names the option in the message).
+pub fn check_output_dir(flag: &str, dir: &Path) -> Result<(), UsageError> {
+    if dir.as_os_str().is_empty() {
+        return Err(UsageError(format!("{flag}: the output directory is empty")));
+    }
+    let mut probe = Some(dir);
+    while let Some(p) = probe {
+        if p.as_os_str().is_empty() {
+            break; // a relative path: its base is the working directory
+        }
+        match std::fs::metadata(p) {
+            Ok(m) if m.is_dir() => return Ok(()),
+            Ok(_) if p == dir => {
+                return Err(UsageError(format!(
+                    "{flag} {}: exists and is not a directory",
+                    dir.display()
+                )))
+            }
+            Ok(_) => {
+                return Err(UsageError(format!(
+                    "{flag} {}: cannot be created: {} is not a directory",
+                    dir.display(),
+                    p.display()
+                )))
+            }
+            Err(e) if e.kind() == io::ErrorKind::NotFound => probe = p.parent(),
+            Err(e) => {
+                return Err(UsageError(format!(
+                    "{flag} {}: cannot inspect {}: {e}",
+                    dir.display(),
+                    p.display()
+                )))
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Creates `path` and writes it through a buffer with `body`; an error names the file.
+pub fn write_file(
+    path: &Path,
+    body: impl FnOnce(&mut BufWriter<File>) -> io::Result<()>,
+) -> anyhow::Result<()> {
+    let file = File::create(path).with_context(|| format!("creating {}", path.display()))?;
+    let mut w = BufWriter::new(file);
+    body(&mut w)
+        .and_then(|()| w.flush())
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+/// The temporary name a file is written under until its set is complete: `.partial` before
+/// the extension (plotters picks the image format from the extension).
+fn partial_name(name: &str) -> String {
+    match name.rsplit_once('.') {
+        Some((stem, ext)) => format!("{stem}.partial.{ext}"),
+        None => format!("{name}.partial"),
+    }
+}
+
+/// The files one command writes into one directory, renamed into place together (see the
+/// module docs).
+#[derive(Debug)]
+pub struct OutputSet {
+    dir: PathBuf,
+    /// Every file name the command may write.
+    owned: Vec<String>,
+    /// Files staged so far: final name, temporary path.
+    staged: Vec<(String, PathBuf)>,
+    /// Temporary files kept if the run fails (they explain it).
+    keep_on_failure: Vec<PathBuf>,
+    /// Directories this set created, innermost first (removed again on failure if empty).
+    created: Vec<PathBuf>,
+    committed: bool,
+}
+
+impl OutputSet {
+    /// Checks `dir` (named by `flag` in errors), creates it if needed and makes sure a file can
+    /// be written in it: all before any work. `owned` are the file names the command writes.
+    pub fn prepare(flag: &str, dir: &Path, mut owned: Vec<String>) -> Result<Self, UsageError> {
+        check_output_dir(flag, dir)?;
+        owned.sort();
+        owned.dedup();
+        let mut created = Vec::new();
+        let mut p = Some(dir);
+        while let Some(d) = p.filter(|d| !d.as_os_str().is_empty() && !d.exists()) {
+            created.push(d.to_path_buf());
+            p = d.parent();
+        }
+        // Built first, so that a failure below removes what was created.
+        let set = Self {
+            dir: dir.to_path_buf(),
+            owned,
+            staged: Vec::new(),
+            keep_on_failure: Vec::new(),
+            created,
+            committed: false,
+        };
+        let unusable =
+            |e: io::Error| UsageError(format!("{flag} {}: cannot write there: {e}", dir.display()));
+        std::fs::create_dir_all(dir).map_err(unusable)?;
+        let probe = dir.join(format!(".tss-sim-probe-{}", std::process::id()));
+        File::create(&probe)
+            .and_then(|mut f| f.write_all(b"probe"))
+            .map_err(unusable)?;
+        std::fs::remove_file(&probe).map_err(unusable)?;
+        // A directory where a result goes would make its rename fail after all the work.
+        for name in &set.owned {
+            let path = dir.join(name);
+            if path.is_dir() {
+                return Err(UsageError(format!(
+                    "{flag} {}: {} is a directory, where the file {name} goes",
+                    dir.display(),
+                    path.display()
+                )));
+            }
+        }
+        Ok(set)
+    }
+
+    /// The output directory.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// The temporary path to write the file `name` to; it is renamed to `name` by
+    /// [`OutputSet::commit`].
+    pub fn stage(&mut self, name: &str) -> PathBuf {
+        debug_assert!(
+            self.owned
+                .binary_search_by(|o| o.as_str().cmp(name))
+                .is_ok(),
+            "{name} is not among the command's files"
+        );
+        let tmp = self.dir.join(partial_name(name));
+        self.staged.push((name.to_string(), tmp.clone()));
+        tmp
+    }
+
+    /// Writes the file `name` with `body` (under its temporary name); returns its final path.
+    pub fn write(
+        &mut self,
+        name: &str,
+        body: impl FnOnce(&mut BufWriter<File>) -> io::Result<()>,
+    ) -> anyhow::Result<PathBuf> {
+        let tmp = self.stage(name);
+        write_file(&tmp, body)?;
+        Ok(self.dir.join(name))
+    }
+
+    /// Has the file `name` been staged?
+    pub fn is_staged(&self, name: &str) -> bool {
+        self.staged.iter().any(|(n, _)| n == name)
+    }
+
+    /// Keeps the staged file `name` under its temporary name if the run fails.
+    pub fn keep_on_failure(&mut self, name: &str) {
+        self.keep_on_failure.push(self.dir.join(partial_name(name)));
+    }
+
+    /// How many files are staged (a mark for [`OutputSet::abandon_since`]).
+    pub fn mark(&self) -> usize {
+        self.staged.len()
+    }
+
+    /// Drops the files staged since `mark` (a part that failed, e.g. the figures): they are not
+    /// committed, and their earlier versions are removed by the commit.
+    pub fn abandon_since(&mut self, mark: usize) {
+        for (_, tmp) in self.staged.drain(mark.min(self.staged.len())..) {
+            let _ = std::fs::remove_file(tmp);
+        }
+    }
+
+    /// Renames every staged file into place and removes the command's other files (those of
+    /// an earlier run that this one did not write).
+    pub fn commit(mut self) -> anyhow::Result<()> {
+        for name in &self.owned {
+            if self.staged.iter().any(|(n, _)| n == name) {
+                continue;
+            }
+            let stale = self.dir.join(name);
+            match std::fs::remove_file(&stale) {
+                Ok(()) => {}
+                Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+                Err(e) => {
+                    return Err(e).with_context(|| {
+                        format!("removing {} (an earlier run's file)", stale.display())
+                    })
+                }
+            }
+            let _ = std::fs::remove_file(self.dir.join(partial_name(name)));
+        }
+        for (name, tmp) in &self.staged {
+            let to = self.dir.join(name);
+            std::fs::rename(tmp, &to)
+                .with_context(|| format!("renaming {} to {}", tmp.display(), to.display()))?;
+        }
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for OutputSet {
+    /// A set dropped without [`OutputSet::commit`] is a failed run: its temporary files go
+    /// (but those that explain the failure), and so do the directories it created, if empty.
+    fn drop(&mut self) {
+        if self.committed {
+            return;
+        }
+        for (_, tmp) in &self.staged {
+            if !self.keep_on_failure.contains(tmp) {
+                let _ = std::fs::remove_file(tmp);
+            }
+        }
+        for d in &self.created {
+            if std::fs::remove_dir(d).is_err() {
+                break;
+            }
+        }
+    }
+}
 
 /// The fixed leading columns of `history.csv`.
 pub const HISTORY_COLUMNS: [&str; 10] = [
@@ -61,6 +299,60 @@ pub fn write_history_csv<W: Write>(mut w: W, samples: &[Sample]) -> io::Result<(
             s.law_rate_mps,
             s.blend_weight,
             s.flags,
+        )?;
+    }
+    w.flush()
+}
+
+/// The columns the elastic plant's `history.csv` adds after [`HISTORY_EXTRA_COLUMNS`]
+/// (`length_m` is then the paid-out length at the reel, `tension_n` the tension there).
+pub const HISTORY_ELASTIC_COLUMNS: [&str; 6] = [
+    "range_m",
+    "tension_tip_n",
+    "bowing_m",
+    "alpha_sensed_rad",
+    "reel_rate_mps",
+    "beads",
+];
+
+/// Writes the elastic plant's history: the columns of [`write_history_csv`], then
+/// [`HISTORY_ELASTIC_COLUMNS`] from `elastic` (one per sample).
+pub fn write_elastic_history_csv<W: Write>(
+    mut w: W,
+    samples: &[Sample],
+    elastic: &[crate::plant::ElasticObservation],
+) -> io::Result<()> {
+    writeln!(
+        w,
+        "{},{}",
+        history_header(),
+        HISTORY_ELASTIC_COLUMNS.join(",")
+    )?;
+    for (s, e) in samples.iter().zip(elastic) {
+        writeln!(
+            w,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            s.t_s,
+            s.length_m,
+            s.length_rate_mps,
+            s.alpha_rad,
+            s.alpha_ref_rad,
+            s.delta_rad,
+            s.delta_rate_radps,
+            s.beta_rad,
+            s.tension_n,
+            s.phase.as_str(),
+            s.alpha_rate_radps,
+            s.length_accel_mps2,
+            s.law_rate_mps,
+            s.blend_weight,
+            s.flags,
+            e.range_m,
+            e.tension_tip_n,
+            e.bowing_m,
+            e.alpha_sensed_rad,
+            e.reel_rate_mps,
+            e.beads,
         )?;
     }
     w.flush()

@@ -12,10 +12,13 @@
 //! **Link faults.** The scenario's `[link]` section injects faults into the sample frames, each
 //! frame meeting at most one: dropped (not sent; the firmware times out), corrupted (one byte
 //! changed, never to the delimiter; the firmware rejects it), duplicated (sent twice; the
-//! firmware discards the copy) or reordered (held back and sent late, after the next period's
-//! frame; the firmware times out, then discards it). Both sides count: the injector here
-//! ([`Injected`]), the firmware in its `Report` and log. [`PilReport::expected_firmware_counts`]
-//! says what the firmware must have seen.
+//! firmware discards the copy) or reordered (held back and sent late, just before the next
+//! period's frame, or before `End`; the firmware times out, then discards it). Both sides
+//! count: the injector here ([`Injected`]), the firmware in its `Report` and log.
+//! [`PilReport::expected_firmware_counts`] says what the firmware must have seen, exactly,
+//! whichever frames are lost: the firmware awaits tick 0 from the start (a lost first frame is
+//! a timeout like any other), and the `End` frame's sequence number reveals frames lost at the
+//! end. A run has at most [`link::MAX_TICKS`] periods ([`check_duration`]).
 //!
 //! **Time.** Lock-step: the firmware blocks on each sample, the plant on each command, and the
 //! tick number in the frames is the authority. The firmware's sample timeout is counted in its
@@ -96,6 +99,19 @@ pub enum PilError {
         firmware: u32,
         /// Digest of the scenario's configuration.
         scenario: u32,
+    },
+    /// The scenario has more control periods than one PIL run may ([`link::MAX_TICKS`]).
+    #[error(
+        "simulation.duration_s = {duration_s} s is {ticks} control periods: a PIL run has at \
+         most {max} (the firmware's bound, link::MAX_TICKS)"
+    )]
+    TooLong {
+        /// The scenario's duration, s.
+        duration_s: f64,
+        /// Its control periods (ticks 0 ..= duration / period).
+        ticks: f64,
+        /// The bound.
+        max: u32,
     },
     /// The firmware broke the protocol, stopped answering or failed.
     #[error("{0} (the firmware's log: {1})")]
@@ -739,6 +755,20 @@ fn wait_exit(child: &mut Child, timeout: Duration) -> Option<ExitStatus> {
     }
 }
 
+/// Checks that `sc` fits in one PIL run ([`link::MAX_TICKS`] control periods).
+pub fn check_duration(sc: &Scenario) -> Result<(), PilError> {
+    let ticks = (sc.simulation.duration_s / sc.controller.period_s).round() + 1.0;
+    if ticks <= f64::from(link::MAX_TICKS) {
+        Ok(())
+    } else {
+        Err(PilError::TooLong {
+            duration_s: sc.simulation.duration_s,
+            ticks,
+            max: link::MAX_TICKS,
+        })
+    }
+}
+
 /// Runs `sc` with the firmware `firmware` in the loop (QEMU), its log written to `log`:
 /// the same history as [`sim::run`], and the link's report.
 pub fn run(
@@ -749,73 +779,10 @@ pub fn run(
     progress: &mut dyn FnMut(f64),
 ) -> Result<(History, PilReport), SimError> {
     let wrap = |e: PilError| SimError::Link(Box::new(e));
+    check_duration(sc).map_err(wrap)?;
     let mut link = PilLink::start(sc, firmware, log).map_err(wrap)?;
     let history = sim::run_stepper::<f32, _>(sc, &mut link, probe_times_s, progress)?;
     let ticks = history.faults.ticks;
     let report = link.finish(ticks).map_err(wrap)?;
     Ok((history, report))
-}
-
-/// The `--pil` options of `tss-sim run`.
-#[derive(clap::Args, Clone, Debug, Default)]
-pub struct PilArgs {
-    /// Processor-in-the-loop: fly the flight firmware in QEMU (mps2-an386) over its UART
-    /// instead of the controller linked into the simulator. Writes the same outputs, plus the
-    /// firmware's log (firmware.log) and the link's report (pil.txt).
-    #[arg(id = "pil", long = "pil")]
-    pub enabled: bool,
-    /// The firmware ELF for --pil; it is not built here (`cargo fw-build` builds it)
-    /// [default: target/thumbv7em-none-eabihf/firmware/tss-reel].
-    #[arg(long, value_name = "ELF", requires = "pil")]
-    pub firmware: Option<PathBuf>,
-}
-
-/// `tss-sim run --pil`: [`run`] through `run_cmd::run_with`, then `pil.txt`.
-///
-/// Unlike a host-linked run, the output directory is created when the simulation starts: the
-/// firmware's log is written there as it runs (and explains a failed run).
-pub fn run_cmd(args: &crate::run_cmd::RunArgs) -> anyhow::Result<()> {
-    use crate::run_cmd::{self, UsageError};
-    use anyhow::Context as _;
-
-    let firmware = args
-        .pil
-        .firmware
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(DEFAULT_FIRMWARE));
-    if !firmware.is_file() {
-        return Err(UsageError(PilError::MissingFirmware(firmware).to_string()).into());
-    }
-    let mut report = None;
-    let mut outcome = run_cmd::run_with(args, |sc, probes, progress| {
-        let dir = run_cmd::output_dir(args, sc);
-        std::fs::create_dir_all(&dir).map_err(|e| {
-            SimError::Link(Box::new(PilError::Io {
-                context: format!("creating {}", dir.display()),
-                source: e,
-            }))
-        })?;
-        let (history, r) = run(sc, &firmware, &dir.join(FIRMWARE_LOG), probes, progress)?;
-        report = Some(r);
-        Ok::<_, SimError>(history)
-    })?;
-    let report = report.context("the PIL run returned no report")?;
-    let text = report.render();
-    let pil_txt = outcome.dir.join("pil.txt");
-    std::fs::write(&pil_txt, &text).with_context(|| format!("writing {}", pil_txt.display()))?;
-    outcome.report.push('\n');
-    outcome.report.push_str(&text);
-    run_cmd::print_outcome(&outcome);
-    println!("  {}", pil_txt.display());
-    println!("  {}", outcome.dir.join(FIRMWARE_LOG).display());
-    if let Some(e) = outcome.figure_error.take() {
-        return Err(e.context("the figures were not drawn (every other output was written)"));
-    }
-    if !report.consistent() {
-        anyhow::bail!(
-            "the two ends of the link disagree on what happened (see {})",
-            pil_txt.display()
-        );
-    }
-    Ok(())
 }

@@ -1,15 +1,18 @@
-//! The plant: the paper's equations of motion (Eq. 5, SPEC §2) in f64, with a rate-commanded
-//! reel, integrated by fixed-step RK4.
+//! The plant: what the closed loop (`crate::sim`) flies, behind one trait ([`Plant`]: observe,
+//! then step one control period), and the rigid plant: the paper's equations of motion (Eq. 5,
+//! docs/equations.md §2) in f64, with a rate-commanded reel, integrated by fixed-step RK4.
 //!
-//! The reel imposes l and l̇ (the commanded rate, held over each control period: zero-order
-//! hold, as the firmware does), so the state integrated is (θ, l, α, α̇, β, β̇) and Eq. 5a gives
-//! the tension the reel must hold.
+//! The rigid plant's reel imposes l and l̇ (the commanded rate, held over each control period:
+//! zero-order hold, as the firmware does), so the state integrated is (θ, l, α, α̇, β, β̇) and
+//! Eq. 5a gives the tension the reel must hold. The other plant is the elastic truth model,
+//! `crate::elastic`.
 
+use crate::reel::{Reel, ReelSaturation};
 use nalgebra::SVector;
 use tss_reel::mass::{MassCoefficients, MassModel};
 use tss_reel::orbit::Orbit;
 
-/// Plant state: θ (true anomaly), l, α, α̇, β, β̇ (rad, m, rad/s).
+/// Rigid plant state: θ (true anomaly), l, α, α̇, β, β̇ (rad, m, rad/s).
 pub type State = SVector<f64, 6>;
 
 /// Indices into [`State`].
@@ -30,7 +33,7 @@ pub mod ix {
 
 /// The physical system: orbit and masses.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Plant {
+pub struct RigidModel {
     /// Orbit of the centre of mass.
     pub orbit: Orbit<f64>,
     /// Masses and tether density.
@@ -50,7 +53,34 @@ struct Frozen {
     massless: Option<MassCoefficients<f64>>,
 }
 
-impl Plant {
+/// The terms Eqs. 5b and 5c share at one state (see [`RigidModel::terms`]).
+#[derive(Clone, Copy, Debug)]
+struct Terms {
+    /// θ̇, rad/s.
+    theta_rate: f64,
+    /// θ̈, rad/s².
+    theta_accel: f64,
+    /// μ/R³, 1/s².
+    gg: f64,
+    /// θ̇ + α̇, rad/s.
+    spin: f64,
+    /// (2 + μ3) l̇/l, 1/s.
+    stretch: f64,
+}
+
+impl Terms {
+    /// Eq. 5b: α̈ = −(θ̇ + α̇)[(2 + μ3) l̇/l − 2β̇ tan β] − (3/2)(μ/R³) sin 2α − θ̈, with
+    /// `beta_coupling` = 2β̇ tan β (0 in the orbit plane: `stretch − 0` is `stretch` exactly,
+    /// so the in-plane shortcut is the same equation bit for bit).
+    #[inline]
+    fn alpha_accel(&self, alpha: f64, beta_coupling: f64) -> f64 {
+        -self.spin * (self.stretch - beta_coupling)
+            - 1.5 * self.gg * (2.0 * alpha).sin()
+            - self.theta_accel
+    }
+}
+
+impl RigidModel {
     /// The state-independent quantities of this plant (see [`Frozen`]).
     fn frozen(&self) -> Frozen {
         let circular = (self.orbit.eccentricity == 0.0).then(|| {
@@ -89,38 +119,47 @@ impl Plant {
         }
     }
 
+    /// The terms of Eqs. 5b and 5c at true anomaly θ and length l with the reel at l̇ =
+    /// `rate_mps` and α̇ = `alpha_rate`: the orbit's θ̇, θ̈ and μ/R³, the spin θ̇ + α̇ and the
+    /// stretch (2 + μ3) l̇/l.
+    #[inline]
+    fn terms(&self, f: &Frozen, theta: f64, l: f64, alpha_rate: f64, rate_mps: f64) -> Terms {
+        let (theta_rate, theta_accel, gg) = self.orbit_terms(f, theta);
+        let mu3 = self.mass_terms(f, l).mu3;
+        Terms {
+            theta_rate,
+            theta_accel,
+            gg,
+            spin: theta_rate + alpha_rate,
+            stretch: (2.0 + mu3) * rate_mps / l,
+        }
+    }
+
     /// Time derivative of the state with the reel running at `rate_mps` (Eqs. 5b, 5c).
     pub fn derivative(&self, x: &State, rate_mps: f64) -> State {
         self.derivative_with(&self.frozen(), x, rate_mps)
     }
 
-    /// [`Plant::derivative`] with the state-independent quantities already evaluated.
+    /// [`RigidModel::derivative`] with the state-independent quantities already evaluated.
     #[inline]
     fn derivative_with(&self, f: &Frozen, x: &State, rate_mps: f64) -> State {
-        let theta = x[ix::THETA];
-        let l = x[ix::LENGTH];
         let (alpha, alpha_rate) = (x[ix::ALPHA], x[ix::ALPHA_RATE]);
         let (beta, beta_rate) = (x[ix::BETA], x[ix::BETA_RATE]);
-        let (theta_rate, theta_accel, gg) = self.orbit_terms(f, theta);
-        let mu3 = self.mass_terms(f, l).mu3;
-        let spin = theta_rate + alpha_rate;
-        let stretch = (2.0 + mu3) * rate_mps / l;
+        let t = self.terms(f, x[ix::THETA], x[ix::LENGTH], alpha_rate, rate_mps);
         if beta == 0.0 && beta_rate == 0.0 {
             // In the orbit plane (β = β̇ = 0, which Eq. 5c keeps): tan β = sin 2β = 0, so the
             // β terms vanish and β̈ = 0.
-            let alpha_accel = -spin * stretch - 1.5 * gg * (2.0 * alpha).sin() - theta_accel;
-            return State::from([theta_rate, rate_mps, alpha_rate, alpha_accel, 0.0, 0.0]);
+            let alpha_accel = t.alpha_accel(alpha, 0.0);
+            return State::from([t.theta_rate, rate_mps, alpha_rate, alpha_accel, 0.0, 0.0]);
         }
-        // Eq. 5b
-        let alpha_accel = -spin * (stretch - 2.0 * beta_rate * beta.tan())
-            - 1.5 * gg * (2.0 * alpha).sin()
-            - theta_accel;
+        let alpha_accel = t.alpha_accel(alpha, 2.0 * beta_rate * beta.tan());
         // Eq. 5c
+        let (spin, stretch, gg) = (t.spin, t.stretch, t.gg);
         let beta_accel = -stretch * beta_rate
             - 0.5 * spin * spin * (2.0 * beta).sin()
             - 1.5 * gg * alpha.cos().powi(2) * (2.0 * beta).sin();
         State::from([
-            theta_rate,
+            t.theta_rate,
             rate_mps,
             alpha_rate,
             alpha_accel,
@@ -150,19 +189,15 @@ impl Plant {
         x + (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h_s / 6.0)
     }
 
-    /// [`Plant::rk4_step_varying`] from a state in the orbit plane (β = β̇ = 0, which every
+    /// [`RigidModel::rk4_step_varying`] from a state in the orbit plane (β = β̇ = 0, which every
     /// stage keeps: the β rows of the derivative are 0), on the four in-plane components only.
     /// Each component goes through the general step's operations in the same order, so the
     /// result is the same bit for bit (β and β̇ end at +0, as 0 + 0 does).
     fn rk4_in_plane(&self, f: &Frozen, x: &State, [v0, v1, v2]: [f64; 3], h_s: f64) -> State {
         // (θ̇, l̇, α̇, α̈) at (θ, l, α, α̇) with the reel at `v`: Eq. 5b in the plane.
         let d = |y: [f64; 4], v: f64| -> [f64; 4] {
-            let (theta_rate, theta_accel, gg) = self.orbit_terms(f, y[0]);
-            let mu3 = self.mass_terms(f, y[1]).mu3;
-            let spin = theta_rate + y[3];
-            let stretch = (2.0 + mu3) * v / y[1];
-            let alpha_accel = -spin * stretch - 1.5 * gg * (2.0 * y[2]).sin() - theta_accel;
-            [theta_rate, v, y[3], alpha_accel]
+            let t = self.terms(f, y[0], y[1], y[3], v);
+            [t.theta_rate, v, y[3], t.alpha_accel(y[2], 0.0)]
         };
         let stage = |k: [f64; 4], c: f64| -> [f64; 4] {
             [
@@ -210,19 +245,196 @@ impl Plant {
     }
 }
 
+/// The reel command of one control period (held over it: zero-order hold).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Command {
+    /// Commanded reel rate l̇, m/s.
+    pub rate_mps: f64,
+    /// The acceleration the controller commanded with it, m/s² (the rigid plant's tension of
+    /// Eq. 5a under the ideal reel uses it).
+    pub accel_mps2: f64,
+}
+
+/// What the sensors would read without errors.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SensorTruth {
+    /// The reel encoder's length (the paid-out length), m.
+    pub length_m: f64,
+    /// α of the sensed direction, rad.
+    pub alpha_rad: f64,
+    /// α̇ of the sensed direction, rad/s.
+    pub alpha_rate_radps: f64,
+    /// Orbit rate θ̇, rad/s.
+    pub orbit_rate_radps: f64,
+}
+
+/// What the elastic plant adds to a recorded instant.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ElasticObservation {
+    /// Distance between the end bodies, m.
+    pub range_m: f64,
+    /// Tension at the sub-satellite, N.
+    pub tension_tip_n: f64,
+    /// Largest lateral deviation of the tether from the line between the end bodies, m.
+    pub bowing_m: f64,
+    /// α the controller's sensor sees (line or exit direction), rad.
+    pub alpha_sensed_rad: f64,
+    /// The reel's actual rate, m/s.
+    pub reel_rate_mps: f64,
+    /// Number of beads.
+    pub beads: usize,
+}
+
+/// One instant of a plant, as the loop records it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Observation {
+    /// What the sensors see (before their errors).
+    pub sensors: SensorTruth,
+    /// Paid-out length at the reel, m.
+    pub length_m: f64,
+    /// α of the line main satellite → sub-satellite, rad (truth).
+    pub alpha_rad: f64,
+    /// α̇ of that line, rad/s.
+    pub alpha_rate_radps: f64,
+    /// β of that line, rad.
+    pub beta_rad: f64,
+    /// Tension at the reel, N.
+    pub tension_n: f64,
+    /// Which reel limits act on the command of this period.
+    pub reel: ReelSaturation,
+    /// The elastic plant's extra quantities (`None` for the rigid plant).
+    pub elastic: Option<ElasticObservation>,
+}
+
+/// A plant the closed loop can fly: observed at the start of each control period (with the
+/// command about to be held, for the quantities that depend on it), then stepped over it.
+pub trait Plant {
+    /// The plant now, under `command` for the period starting now.
+    fn observe(&self, command: &Command) -> Observation;
+    /// Advances one control period of `period_s` with `command` held.
+    fn step(&mut self, command: &Command, period_s: f64);
+    /// `false` once the state stopped being finite (a physically impossible run).
+    fn is_finite(&self) -> bool;
+    /// The tether's shape (node positions relative to the main satellite in the orbit frame
+    /// e_r, e_θ, e_h, m), if the plant has one beyond a straight line.
+    fn shape(&self) -> Option<Vec<[f64; 3]>> {
+        None
+    }
+}
+
+/// The rigid plant flying: Eq. 5's state, its reel drive (ideal, or lagging and saturating),
+/// the RK4 substeps per period, and whether the reel is locked.
+#[derive(Clone, Debug)]
+pub struct RigidPlant {
+    /// The equations.
+    pub model: RigidModel,
+    /// The state.
+    pub x: State,
+    /// The reel drive.
+    pub reel: Reel,
+    /// RK4 substeps per control period (≥ 1).
+    pub substeps: u32,
+    /// Reel locked: l̇ = 0 whatever the command.
+    pub locked: bool,
+    /// The control period the reel's saturation flags are judged over, s.
+    pub period_s: f64,
+}
+
+impl RigidPlant {
+    /// The command the reel applies (zero while locked).
+    fn applied(&self, command: &Command) -> Command {
+        if self.locked {
+            Command::default()
+        } else {
+            *command
+        }
+    }
+}
+
+impl Plant for RigidPlant {
+    fn observe(&self, command: &Command) -> Observation {
+        let x = &self.x;
+        let c = self.applied(command);
+        // The tension of Eq. 5a at the start of the period: with the ideal reel l̈ is the
+        // commanded acceleration; with a real drive, its actual rate and acceleration.
+        let (tension_n, reel) = if self.reel.is_ideal() {
+            let t = self.model.tension_n(x, c.rate_mps, c.accel_mps2);
+            (t, ReelSaturation::default())
+        } else {
+            let rate = c.rate_mps;
+            let (v, a) = (
+                self.reel.rate_after(rate, 0.0),
+                self.reel.accel_after(rate, 0.0),
+            );
+            let t = self.model.tension_n(x, v, a);
+            (t, self.reel.saturation(rate, self.period_s))
+        };
+        Observation {
+            sensors: SensorTruth {
+                length_m: x[ix::LENGTH],
+                alpha_rad: x[ix::ALPHA],
+                alpha_rate_radps: x[ix::ALPHA_RATE],
+                orbit_rate_radps: self.model.orbit_rate_radps(x[ix::THETA]),
+            },
+            length_m: x[ix::LENGTH],
+            alpha_rad: x[ix::ALPHA],
+            alpha_rate_radps: x[ix::ALPHA_RATE],
+            beta_rad: x[ix::BETA],
+            tension_n,
+            reel,
+            elastic: None,
+        }
+    }
+
+    fn step(&mut self, command: &Command, period_s: f64) {
+        let rate = self.applied(command).rate_mps;
+        let h = period_s / f64::from(self.substeps);
+        if self.reel.is_ideal() {
+            for _ in 0..self.substeps {
+                self.x = self.model.rk4_step(&self.x, rate, h);
+            }
+        } else {
+            for k in 0..self.substeps {
+                self.x = rk4_with_reel(&self.model, &self.x, &self.reel, rate, f64::from(k) * h, h);
+            }
+            self.reel.advance(rate, period_s);
+        }
+    }
+
+    fn is_finite(&self) -> bool {
+        self.x.iter().all(|v| v.is_finite())
+    }
+}
+
+/// One RK4 step of `h_s` seconds starting `t0_s` into the period, with the reel's rate v(t)
+/// under the held command (`reel` is the drive at the start of the period): each stage sees
+/// the rate at its own time, so l integrates v(t) (Simpson's rule) and Eq. 5b sees l̇ = v(t).
+fn rk4_with_reel(
+    model: &RigidModel,
+    x: &State,
+    reel: &Reel,
+    command_mps: f64,
+    t0_s: f64,
+    h_s: f64,
+) -> State {
+    let v = |t: f64| reel.rate_after(command_mps, t);
+    let (v0, v1, v2) = (v(t0_s), v(t0_s + 0.5 * h_s), v(t0_s + h_s));
+    model.rk4_step_varying(x, [v0, v1, v2], h_s)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn paper_plant() -> Plant {
-        Plant {
+    fn paper_plant() -> RigidModel {
+        RigidModel {
             orbit: Orbit::circular(7_078_000.0),
             masses: MassModel::paper(),
         }
     }
 
     /// Eqs. 5b–5c as written, with every term evaluated (the reference for the shortcuts).
-    fn reference_derivative(p: &Plant, x: &State, rate_mps: f64) -> State {
+    fn reference_derivative(p: &RigidModel, x: &State, rate_mps: f64) -> State {
         let (theta, l, alpha, alpha_rate, beta, beta_rate) = (x[0], x[1], x[2], x[3], x[4], x[5]);
         let theta_rate = p.orbit.true_anomaly_rate_radps(theta);
         let theta_accel = p.orbit.true_anomaly_accel_radps2(theta);
@@ -247,7 +459,7 @@ mod tests {
     }
 
     /// Eq. 5a as written (the reference for the shortcuts).
-    fn reference_tension(p: &Plant, x: &State, rate: f64, accel: f64) -> f64 {
+    fn reference_tension(p: &RigidModel, x: &State, rate: f64, accel: f64) -> f64 {
         let (theta, l) = (x[ix::THETA], x[ix::LENGTH]);
         let c = p.masses.coefficients(l);
         let spin = p.orbit.true_anomaly_rate_radps(theta) + x[ix::ALPHA_RATE];
@@ -262,7 +474,7 @@ mod tests {
     #[test]
     fn shortcuts_are_bit_identical_to_the_equations() {
         for (ecc, rho) in [(0.0, 0.0), (0.0, 1e-3), (0.01, 0.0), (0.01, 1e-3)] {
-            let p = Plant {
+            let p = RigidModel {
                 orbit: Orbit::elliptic(7_078_000.0, ecc),
                 masses: MassModel {
                     tether_density_kg_per_m: rho,

@@ -7,14 +7,18 @@
 //! Text is rendered with plotters' `ttf` feature, which finds a sans-serif system font through
 //! fontconfig (DejaVu Sans on the project's Debian machines, package `fonts-dejavu-core`).
 //! Long histories are thinned with a min/max envelope per bucket, so peaks survive.
+//!
+//! The set-up every figure of tss-sim shares (the Monte Carlo and `extent` figures too) is here:
+//! the [`FONT`], the font check, and [`write_png_and_svg`] for any [`Figure`].
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{anyhow, Context};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::history::{History, Sample};
+use crate::output::OutputSet;
 use crate::scenario::Scenario;
 
 /// Seconds per hour.
@@ -25,8 +29,8 @@ const M_PER_KM: f64 = 1000.0;
 pub const FIGURE_SIZE_PX: (u32, u32) = (1200, 900);
 /// Points drawn per series at most (the rest is thinned, keeping each bucket's min and max).
 pub const MAX_POINTS_PER_SERIES: usize = 4000;
-/// Font family for all text.
-const FONT: &str = "sans-serif";
+/// Font family of every figure's text.
+pub const FONT: &str = "sans-serif";
 
 /// File stems of the figures, in order (each written as `.png` and `.svg`).
 pub const FIGURE_STEMS: [&str; 3] = [
@@ -73,34 +77,80 @@ pub fn check_font() -> anyhow::Result<()> {
         })
 }
 
-/// Writes the three figures to `dir` as PNG and SVG; returns the paths written.
+/// A figure drawn the same on every plotters backend (PNG and SVG).
+pub trait Figure {
+    /// Draws the figure on `root`.
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()>;
+}
+
+/// A plotters drawing error as an [`anyhow::Error`].
+pub fn draw_error<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> anyhow::Error {
+    anyhow!("{e}")
+}
+
+/// The file names of a figure: `<stem>.png` and `<stem>.svg`.
+pub fn png_and_svg(stem: &str) -> [String; 2] {
+    [format!("{stem}.png"), format!("{stem}.svg")]
+}
+
+/// Draws `figure` (`size` pixels) into `<stem>.png` and `<stem>.svg` of `out`; returns their
+/// final paths.
+pub fn write_png_and_svg(
+    out: &mut OutputSet,
+    stem: &str,
+    size: (u32, u32),
+    figure: &impl Figure,
+) -> anyhow::Result<Vec<PathBuf>> {
+    let mut written = Vec::new();
+    for name in png_and_svg(stem) {
+        let tmp = out.stage(&name);
+        let drawn = if name.ends_with(".svg") {
+            let root = SVGBackend::new(&tmp, size).into_drawing_area();
+            figure
+                .draw(&root)
+                .and_then(|()| root.present().map_err(draw_error))
+        } else {
+            let root = BitMapBackend::new(&tmp, size).into_drawing_area();
+            figure
+                .draw(&root)
+                .and_then(|()| root.present().map_err(draw_error))
+        };
+        drawn.with_context(|| format!("drawing {name}"))?;
+        written.push(out.dir().join(&name));
+    }
+    Ok(written)
+}
+
+/// The file names of the run's figures.
+pub fn figure_names() -> Vec<String> {
+    FIGURE_STEMS.iter().flat_map(|s| png_and_svg(s)).collect()
+}
+
+/// A figure of panels stacked vertically.
+struct Panels(Vec<Panel>);
+
+impl Figure for Panels {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()> {
+        draw(root, &self.0)
+    }
+}
+
+/// Writes the three figures into `out` as PNG and SVG; returns the paths written.
 pub fn write_figures(
-    dir: &Path,
+    out: &mut OutputSet,
     scenario: &Scenario,
     history: &History,
 ) -> anyhow::Result<Vec<PathBuf>> {
     check_font()?;
     let figures = figures(scenario, &history.samples);
     let mut written = Vec::new();
-    for (stem, panels) in FIGURE_STEMS.iter().zip(&figures) {
-        let png = dir.join(format!("{stem}.png"));
-        {
-            let root = BitMapBackend::new(&png, FIGURE_SIZE_PX).into_drawing_area();
-            draw(&root, panels).with_context(|| format!("drawing {}", png.display()))?;
-            root.present()
-                .map_err(|e| anyhow!("{e}"))
-                .with_context(|| format!("writing {}", png.display()))?;
-        }
-        written.push(png);
-        let svg = dir.join(format!("{stem}.svg"));
-        {
-            let root = SVGBackend::new(&svg, FIGURE_SIZE_PX).into_drawing_area();
-            draw(&root, panels).with_context(|| format!("drawing {}", svg.display()))?;
-            root.present()
-                .map_err(|e| anyhow!("{e}"))
-                .with_context(|| format!("writing {}", svg.display()))?;
-        }
-        written.push(svg);
+    for (stem, panels) in FIGURE_STEMS.iter().zip(figures) {
+        written.extend(write_png_and_svg(
+            out,
+            stem,
+            FIGURE_SIZE_PX,
+            &Panels(panels),
+        )?);
     }
     Ok(written)
 }
@@ -244,11 +294,10 @@ fn padded_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 
 /// Draws the panels stacked vertically on `root`.
 fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, panels: &[Panel]) -> anyhow::Result<()> {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow!("{e}");
-    root.fill(&WHITE).map_err(err)?;
+    root.fill(&WHITE).map_err(draw_error)?;
     let areas = root.split_evenly((panels.len(), 1));
     for (area, panel) in areas.iter().zip(panels) {
-        draw_panel(area, panel).map_err(err)?;
+        draw_panel(area, panel).map_err(draw_error)?;
     }
     Ok(())
 }

@@ -1,6 +1,6 @@
 //! The physical reel drive between the controller's rate command and the tether.
 //!
-//! An ideal reel (the paper's assumption, SPEC §7) runs at the commanded rate at once. A real
+//! An ideal reel (the paper's assumption, docs/equations.md §7) runs at the commanded rate at once. A real
 //! drive lags and saturates: its rate v follows the command u as a first-order lag,
 //! dv/dt = (g − v)/τ with g = u clamped to the drive's own rate limit, and |dv/dt| is clamped to
 //! the drive's acceleration limit. Over one control period u is constant (zero-order hold), so
@@ -8,7 +8,37 @@
 //! then the exponential approach. The plant integrates the tether with that v(t) (see
 //! `sim`), and the tension of Eq. 5a takes l̈ = dv/dt.
 
-use crate::scenario::ReelSection;
+/// A reel drive's parameters: its lag and its own saturation (separate from the controller's
+/// envelope).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReelDrive {
+    /// Lag time constant τ, s (0 = the rate follows the command at once).
+    pub lag_s: f64,
+    /// The drive's rate limit, m/s (inf = none).
+    pub max_rate_mps: f64,
+    /// The drive's acceleration limit, m/s² (inf = none).
+    pub max_accel_mps2: f64,
+}
+
+impl ReelDrive {
+    /// The ideal drive of the paper: no lag, no saturation.
+    pub const IDEAL: Self = Self {
+        lag_s: 0.0,
+        max_rate_mps: f64::INFINITY,
+        max_accel_mps2: f64::INFINITY,
+    };
+
+    /// `true` if the drive lags or saturates.
+    pub fn is_ideal(&self) -> bool {
+        *self == Self::IDEAL
+    }
+}
+
+impl Default for ReelDrive {
+    fn default() -> Self {
+        Self::IDEAL
+    }
+}
 
 /// The drive's lag and saturation, and its current rate.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -33,8 +63,8 @@ pub struct ReelSaturation {
 }
 
 impl Reel {
-    /// The drive a scenario describes, at rest at `initial_rate_mps` (clamped to its limit).
-    pub fn new(cfg: &ReelSection, initial_rate_mps: f64) -> Self {
+    /// The drive `cfg`, running at `initial_rate_mps` (clamped to its limit).
+    pub fn new(cfg: &ReelDrive, initial_rate_mps: f64) -> Self {
         Self {
             lag_s: cfg.lag_s,
             max_rate_mps: cfg.max_rate_mps,
@@ -45,9 +75,12 @@ impl Reel {
 
     /// `true` if the drive is the ideal one: no lag, no saturation (then v = u exactly).
     pub fn is_ideal(&self) -> bool {
-        self.lag_s == 0.0
-            && self.max_rate_mps == f64::INFINITY
-            && self.max_accel_mps2 == f64::INFINITY
+        ReelDrive {
+            lag_s: self.lag_s,
+            max_rate_mps: self.max_rate_mps,
+            max_accel_mps2: self.max_accel_mps2,
+        }
+        .is_ideal()
     }
 
     /// The rate the drive heads for under command `command_mps` (its own rate limit applied).
@@ -140,7 +173,7 @@ mod tests {
 
     #[test]
     fn the_ideal_reel_runs_at_the_command() {
-        let r = Reel::new(&ReelSection::default(), 0.1);
+        let r = Reel::new(&ReelDrive::IDEAL, 0.1);
         assert!(r.is_ideal());
         assert_eq!(r.rate_after(3.0, 0.0), 3.0);
         assert_eq!(r.rate_after(3.0, 0.5), 3.0);

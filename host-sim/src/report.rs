@@ -5,10 +5,15 @@
 //! crossing. The keep lengths are approached asymptotically (retrieval toward 2 km creeps in
 //! from above), so "reaching" a keep length means coming within [`KEEP_ARRIVAL_TOLERANCE_M`] of
 //! it: stage 1 first l ≥ keep₁ − tol, stage 2 first l ≤ keep₂ + tol.
+//!
+//! The summary claims only what the history shows: a landmark is reached when the length
+//! *crosses* its level, from a finite sample on the other side (a tether that stays at 4 m
+//! never "reaches 2 km" by retrieval, however the phases run), and the stage-1 overshoot is
+//! given only once the keep length was reached.
 
 use std::fmt::Write as _;
 
-use crate::history::{History, PhaseLabel, Sample};
+use crate::history::{flag_names, History, PhaseLabel, Sample, FLAG_NAMES};
 use crate::scenario::Scenario;
 
 /// How close to a keep length counts as having reached it, m (the paper's Table 1 has the
@@ -79,19 +84,25 @@ pub struct Summary {
     pub tension: Vec<TensionRange>,
     /// Samples whose controller flags are not zero, and the OR of all flags.
     pub flagged: (usize, u32),
+    /// For each flag raised in the run: its name and the samples that carry it.
+    pub flag_counts: Vec<(&'static str, usize)>,
     /// The last sample.
     pub last: Option<Sample>,
 }
 
-/// First time, interpolated, at which `reached(l)` becomes true among `samples` (which must be
-/// in time order); `level` is the crossing level used for the interpolation.
+/// First time, interpolated, at which the length crosses into `reached` among `samples` (in
+/// time order) from a finite sample outside it; `level` is the crossing level used for the
+/// interpolation. `None` if the length is never seen outside `reached` and then inside it.
 fn first_crossing(samples: &[&Sample], level: f64, reached: impl Fn(f64) -> bool) -> Option<f64> {
-    let i = samples.iter().position(|s| reached(s.length_m))?;
-    let cur = samples[i];
-    if i == 0 {
-        return Some(cur.t_s);
-    }
-    let prev = samples[i - 1];
+    let outside = samples
+        .iter()
+        .position(|s| s.length_m.is_finite() && !reached(s.length_m))?;
+    let i = outside
+        + samples[outside..]
+            .iter()
+            .position(|s| reached(s.length_m))?;
+    // i > outside ≥ 0: there is a sample before the crossing.
+    let (prev, cur) = (samples[i - 1], samples[i]);
     let dl = cur.length_m - prev.length_m;
     if dl == 0.0 || !dl.is_finite() {
         return Some(cur.t_s);
@@ -114,6 +125,13 @@ pub fn summarize(scenario: &Scenario, history: &History) -> Summary {
     let samples = &history.samples;
     let stage1: Vec<&Sample> = samples.iter().filter(|s| is_stage1(s.phase)).collect();
     let stage2: Vec<&Sample> = samples.iter().filter(|s| !is_stage1(s.phase)).collect();
+    // Retrieval starts where stage 1 left the tether: its crossings count from there.
+    let from_stage1_end: Vec<&Sample> = stage1
+        .last()
+        .into_iter()
+        .chain(stage2.iter())
+        .copied()
+        .collect();
     let s1 = &scenario.stage1;
     let s2 = &scenario.stage2;
     let tol = KEEP_ARRIVAL_TOLERANCE_M;
@@ -143,7 +161,7 @@ pub fn summarize(scenario: &Scenario, history: &History) -> Summary {
                 km(s2.band_start_m)
             ),
             level_m: s2.band_start_m,
-            t_s: first_crossing(&stage2, s2.band_start_m, |l| l <= s2.band_start_m),
+            t_s: first_crossing(&from_stage1_end, s2.band_start_m, |l| l <= s2.band_start_m),
         },
         Landmark {
             label: format!(
@@ -151,7 +169,7 @@ pub fn summarize(scenario: &Scenario, history: &History) -> Summary {
                 km(s2.keep_length_m)
             ),
             level_m: keep2_level,
-            t_s: first_crossing(&stage2, keep2_level, |l| l <= keep2_level),
+            t_s: first_crossing(&from_stage1_end, keep2_level, |l| l <= keep2_level),
         },
     ];
 
@@ -202,6 +220,12 @@ pub fn summarize(scenario: &Scenario, history: &History) -> Summary {
         (n + usize::from(s.flags != 0), or | s.flags)
     });
 
+    let flag_counts = FLAG_NAMES
+        .iter()
+        .map(|&(bit, name)| (name, samples.iter().filter(|s| s.flags & bit != 0).count()))
+        .filter(|&(_, n)| n > 0)
+        .collect();
+
     Summary {
         name: scenario.name.clone(),
         samples: samples.len(),
@@ -211,7 +235,17 @@ pub fn summarize(scenario: &Scenario, history: &History) -> Summary {
         stage1_max,
         tension,
         flagged,
+        flag_counts,
         last: samples.last().copied(),
+    }
+}
+
+/// A tension for the table: fixed-point, or scientific when too large for its column.
+fn newtons(x: f64) -> String {
+    if x.abs() < 1e6 || !x.is_finite() {
+        format!("{x:>12.6}")
+    } else {
+        format!("{x:>12.4e}")
     }
 }
 
@@ -238,10 +272,20 @@ impl Summary {
             .unwrap_or(0);
         for l in &self.landmarks {
             let pad = width - l.label.chars().count();
-            let when = l.t_s.map_or_else(|| "not reached".to_string(), hours);
+            let when = l.t_s.map_or_else(|| "not in this run".to_string(), hours);
             let _ = writeln!(o, "  {}{:pad$}  {when}", l.label, "");
         }
+        let keep1_reached = self.landmarks.get(1).is_some_and(|l| l.t_s.is_some());
         match self.stage1_max {
+            Some((l, t)) if !keep1_reached => {
+                let _ = writeln!(
+                    o,
+                    "  stage-1 overshoot: none, {} never reached (max l = {:.3} m at {})",
+                    km(self.keep1_m),
+                    l,
+                    hours(t)
+                );
+            }
             Some((l, t)) => {
                 let _ = writeln!(
                     o,
@@ -260,11 +304,11 @@ impl Summary {
         for t in &self.tension {
             let _ = write!(
                 o,
-                "    {:<9} min {:>12.6} at {:>7.3} h   max {:>12.6} at {:>7.3} h   ({} samples",
+                "    {:<9} min {} at {:>7.3} h   max {} at {:>7.3} h   ({} samples",
                 t.phase.as_str(),
-                t.min.0,
+                newtons(t.min.0),
                 t.min.1 / S_PER_H,
-                t.max.0,
+                newtons(t.max.0),
                 t.max.1 / S_PER_H,
                 t.samples
             );
@@ -280,9 +324,16 @@ impl Summary {
         if n == 0 {
             let _ = writeln!(o, "  controller flags: none raised");
         } else {
+            let counts: Vec<String> = self
+                .flag_counts
+                .iter()
+                .map(|(name, k)| format!("{name} {k}"))
+                .collect();
             let _ = writeln!(
                 o,
-                "  controller flags: raised in {n} samples (OR of all = {or:#010x})"
+                "  controller flags: raised in {n} samples: {} (flags column: {or:#x} = {})",
+                counts.join(", "),
+                flag_names(or)
             );
         }
         if let Some(s) = self.last {
@@ -332,6 +383,63 @@ mod tests {
         let t = first_crossing(&[&a, &b], 10_000.0, |l| l >= 10_000.0).unwrap();
         assert!((t - 5.0).abs() < 1e-12);
         assert_eq!(first_crossing(&[&a], 10_000.0, |l| l >= 10_000.0), None);
+    }
+
+    #[test]
+    fn a_level_is_crossed_only_from_the_other_side() {
+        let s = |t, l| sample(t, l, 1.0, PhaseLabel::Retrieve);
+        let (a, b, nan) = (s(0.0, 4.0), s(10.0, 3.0), s(5.0, f64::NAN));
+        // Always below the level: never "reaches" it from above.
+        assert_eq!(first_crossing(&[&a, &b], 2000.5, |l| l <= 2000.5), None);
+        assert_eq!(
+            first_crossing(&[&nan, &a, &b], 2000.5, |l| l <= 2000.5),
+            None
+        );
+        let c = s(20.0, 3000.0);
+        let d = s(30.0, 1000.0);
+        assert_eq!(
+            first_crossing(&[&a, &c, &d], 2000.0, |l| l <= 2000.0),
+            Some(25.0)
+        );
+    }
+
+    /// Issue 16 §2: with `controller.k1_per_s = 1e30` the run kept a 4 m tether while the phases
+    /// ran on, and the summary said "retrieval reaches 2 km at 8.000 h" and gave a stage-1
+    /// "overshoot" of −29 996 m.
+    #[test]
+    fn a_tether_that_never_moves_reaches_nothing() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/paper.toml");
+        let scenario = Scenario::load(path, &[]).unwrap();
+        let h = 3600.0;
+        let samples = vec![
+            sample(0.0, 1.0, 0.5, PhaseLabel::Deploy),
+            sample(4.0 * h, 4.0, -1e29, PhaseLabel::Deploy),
+            sample(7.0 * h, 4.0, -1e29, PhaseLabel::Keep1),
+            sample(8.0 * h, 4.0, -1e29, PhaseLabel::Slew),
+            sample(9.0 * h, 4.0, -1e29, PhaseLabel::Retrieve),
+            sample(20.0 * h, 4.0, -1e29, PhaseLabel::Keep2),
+        ];
+        let hist = History {
+            samples,
+            probes: vec![],
+            ..History::default()
+        };
+        let s = summarize(&scenario, &hist);
+        assert!(
+            s.landmarks.iter().all(|l| l.t_s.is_none()),
+            "{:?}",
+            s.landmarks
+        );
+        let text = s.render();
+        let line = text
+            .lines()
+            .find(|l| l.contains("retrieval reaches 2 km"))
+            .unwrap();
+        assert!(line.ends_with("not in this run"), "{text}");
+        assert!(
+            text.contains("stage-1 overshoot: none, 30 km never reached"),
+            "{text}"
+        );
     }
 
     #[test]

@@ -1,12 +1,16 @@
-//! `tss-sim run SCENARIO [--out DIR] [--set key=value]...`: simulate a mission and write its
-//! history, the paper's Figs. 4–6, the Table-1 comparison and a summary.
+//! `tss-sim run SCENARIO [--out DIR] [--set key=value]... [--pil [--firmware ELF]]`: simulate a
+//! mission and write its history, the paper's Figs. 4–6, the Table-1 comparison and a summary.
 //!
-//! Everything the user gave is checked (scenario, overrides, output directory) before the
-//! simulation starts and before anything is written; such errors are [`UsageError`] or
-//! [`ScenarioError`], which the binary turns into exit code 2.
+//! Everything the user gave is checked (scenario, overrides, output directory, firmware) before
+//! the simulation starts; such errors are [`UsageError`] or [`ScenarioError`], which the binary
+//! turns into exit code 2. The files are written through an [`OutputSet`]: a failed run leaves
+//! the output directory as it was, and a successful one removes the files of the set
+//! ([`output_names`]) that it did not write (`pil.txt` and `firmware.log` of an earlier PIL run,
+//! the figures when they could not be drawn).
+//!
+//! [`ScenarioError`]: crate::scenario::ScenarioError
 
-use std::fs::File;
-use std::io::{BufWriter, IsTerminal, Write};
+use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -14,18 +18,22 @@ use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::history::History;
+use crate::output::{self, OutputSet};
+use crate::pil::{self, PilError, FIRMWARE_LOG};
+use crate::plots;
 use crate::report::summarize;
-use crate::scenario::{Scenario, ScenarioError};
-use crate::table1::{Table1Comparison, PROBE_TIMES_S};
-use crate::{output, plots};
+use crate::scenario::Scenario;
+use crate::sim::SimError;
+use crate::table1::{probe_times_for, Table1Comparison};
+use crate::usage::{quiet, UsageError};
 
 /// Arguments of `tss-sim run`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct RunArgs {
     /// Scenario file (TOML), e.g. scenarios/paper.toml.
     pub scenario: PathBuf,
-    /// Output directory (created if needed; files in it are overwritten)
-    /// [default: out/<scenario name>].
+    /// Output directory (created if needed; the files of an earlier run in it are replaced)
+    /// [default: out/NAME, NAME being the scenario's name].
     #[arg(long, short, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Override one scenario field, dotted key and TOML value, e.g.
@@ -34,34 +42,50 @@ pub struct RunArgs {
     pub set: Vec<String>,
     /// Processor-in-the-loop: `--pil [--firmware ELF]` (see `tss_sim::pil`).
     #[command(flatten)]
-    pub pil: crate::pil::PilArgs,
+    pub pil: PilArgs,
 }
 
-/// A command-line mistake found before any work (exit code 2).
-#[derive(Debug, thiserror::Error)]
-#[error("{0}")]
-pub struct UsageError(pub String);
-
-/// Is `err` (or its cause) the user's mistake — a bad scenario, override or output path — so
-/// that the process should exit with code 2 rather than 1?
-pub fn is_usage_error(err: &anyhow::Error) -> bool {
-    err.chain()
-        .any(|e| e.is::<ScenarioError>() || e.is::<UsageError>())
+/// The `--pil` options of `tss-sim run`.
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct PilArgs {
+    /// Processor-in-the-loop: fly the flight firmware in QEMU (mps2-an386) over its UART
+    /// instead of the controller linked into the simulator. Writes the same outputs, plus the
+    /// firmware's log (firmware.log) and the link's report (pil.txt).
+    #[arg(id = "pil", long = "pil")]
+    pub enabled: bool,
+    /// The firmware ELF for --pil; it is not built here (`cargo fw-build` builds it)
+    /// [default: target/thumbv7em-none-eabihf/firmware/tss-reel].
+    #[arg(long, value_name = "ELF", requires = "pil")]
+    pub firmware: Option<PathBuf>,
 }
 
-/// The files one run writes, and how long its parts took.
+/// The report of the PIL link.
+pub const PIL_TXT: &str = "pil.txt";
+
+/// Every file `tss-sim run` may write into its output directory.
+pub fn output_names() -> Vec<String> {
+    let mut names: Vec<String> = [
+        "history.csv",
+        "table1.csv",
+        "summary.txt",
+        "faults.txt",
+        "scenario.toml",
+        PIL_TXT,
+        FIRMWARE_LOG,
+    ]
+    .map(String::from)
+    .to_vec();
+    names.extend(plots::figure_names());
+    names
+}
+
+/// The files one run wrote, and how long its parts took.
 #[derive(Debug)]
 pub struct RunOutcome {
     /// The output directory.
     pub dir: PathBuf,
-    /// `history.csv`.
-    pub history_csv: PathBuf,
-    /// `table1.csv`.
-    pub table1_csv: PathBuf,
-    /// `summary.txt`.
-    pub summary_txt: PathBuf,
-    /// `scenario.toml`: the scenario as run (file plus overrides).
-    pub scenario_toml: PathBuf,
+    /// Every file written but the figures, in the order written.
+    pub files: Vec<PathBuf>,
     /// The figures, PNG and SVG (empty if they could not be drawn).
     pub figures: Vec<PathBuf>,
     /// Why the figures could not be drawn (the other outputs are written regardless).
@@ -70,16 +94,17 @@ pub struct RunOutcome {
     pub sim_time: Duration,
     /// Wall time of writing every output.
     pub write_time: Duration,
-    /// The text printed on stdout (summary and Table 1).
+    /// The text printed on stdout (summary, Table 1, faults, and the PIL report).
     pub report: String,
 }
 
-/// `tss-sim run`: with the closed-loop simulation [`crate::sim::run`].
+/// `tss-sim run`: with the closed-loop simulation [`crate::sim::run`], or with the firmware in
+/// the loop ([`crate::pil::run`]) under `--pil`.
 pub fn run(args: RunArgs) -> anyhow::Result<()> {
     if args.pil.enabled {
-        return crate::pil::run_cmd(&args);
+        return run_pil(&args);
     }
-    let mut outcome = run_with(&args, |scenario, probes, progress| {
+    let mut outcome = run_with(&args, |scenario, probes, _, progress| {
         crate::sim::run(scenario, probes, progress)
     })?;
     print_outcome(&outcome);
@@ -89,8 +114,54 @@ pub fn run(args: RunArgs) -> anyhow::Result<()> {
     }
 }
 
-/// Prints the report and where the files are.
+/// `tss-sim run --pil`: [`pil::run`] through [`run_with`], plus `pil.txt` and `firmware.log`.
+///
+/// The firmware's log is written as the run goes, as `firmware.partial.log`: if the run fails,
+/// it stays under that name and explains why.
+fn run_pil(args: &RunArgs) -> anyhow::Result<()> {
+    let firmware = args
+        .pil
+        .firmware
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(pil::DEFAULT_FIRMWARE));
+    if !firmware.is_file() {
+        return Err(UsageError(PilError::MissingFirmware(firmware).to_string()).into());
+    }
+    // Checked here too, so that a scenario too long for the firmware is a usage error.
+    let scenario = Scenario::load(&args.scenario, &args.set)?;
+    pil::check_duration(&scenario).map_err(|e| UsageError(e.to_string()))?;
+    let mut report = None;
+    let mut outcome = run_with(args, |sc, probes, out, progress| {
+        let log = out.stage(FIRMWARE_LOG);
+        out.keep_on_failure(FIRMWARE_LOG);
+        let (history, r) = pil::run(sc, &firmware, &log, probes, progress)?;
+        let text = r.render();
+        out.write(PIL_TXT, |w| w.write_all(text.as_bytes()))
+            .map_err(|e| SimError::Link(e.into()))?;
+        report = Some(r);
+        Ok::<_, SimError>(history)
+    })?;
+    let report = report.context("the PIL run returned no report")?;
+    outcome.report.push('\n');
+    outcome.report.push_str(&report.render());
+    print_outcome(&outcome);
+    if let Some(e) = outcome.figure_error.take() {
+        return Err(e.context("the figures were not drawn (every other output was written)"));
+    }
+    if !report.consistent() {
+        anyhow::bail!(
+            "the two ends of the link disagree on what happened (see {})",
+            outcome.dir.join(PIL_TXT).display()
+        );
+    }
+    Ok(())
+}
+
+/// Prints the report and where the files are (nothing under `--quiet`).
 pub fn print_outcome(o: &RunOutcome) {
+    if quiet() {
+        return;
+    }
     let mut stdout = std::io::stdout().lock();
     let _ = write!(stdout, "{}", o.report);
     let _ = writeln!(
@@ -100,12 +171,7 @@ pub fn print_outcome(o: &RunOutcome) {
         o.write_time.as_secs_f64(),
         o.dir.display()
     );
-    for p in [
-        &o.history_csv,
-        &o.table1_csv,
-        &o.summary_txt,
-        &o.scenario_toml,
-    ] {
+    for p in &o.files {
         let _ = writeln!(stdout, "  {}", p.display());
     }
     if o.figure_error.is_none() {
@@ -123,59 +189,8 @@ pub fn output_dir(args: &RunArgs, scenario: &Scenario) -> PathBuf {
         .unwrap_or_else(|| Path::new("out").join(&scenario.name))
 }
 
-/// Checks, without creating anything, that `dir` is a directory or can be created as one.
-pub fn check_output_dir(dir: &Path) -> Result<(), UsageError> {
-    if dir.as_os_str().is_empty() {
-        return Err(UsageError("--out: the output directory is empty".into()));
-    }
-    let mut probe = Some(dir);
-    while let Some(p) = probe {
-        if p.as_os_str().is_empty() {
-            break; // a relative path: its base is the working directory
-        }
-        match std::fs::metadata(p) {
-            Ok(m) if m.is_dir() => return Ok(()),
-            Ok(_) if p == dir => {
-                return Err(UsageError(format!(
-                    "--out {}: exists and is not a directory",
-                    dir.display()
-                )))
-            }
-            Ok(_) => {
-                return Err(UsageError(format!(
-                    "--out {}: cannot be created: {} is not a directory",
-                    dir.display(),
-                    p.display()
-                )))
-            }
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => probe = p.parent(),
-            Err(e) => {
-                return Err(UsageError(format!(
-                    "--out {}: cannot inspect {}: {e}",
-                    dir.display(),
-                    p.display()
-                )))
-            }
-        }
-    }
-    Ok(())
-}
-
-/// The Table-1 instants a run of `scenario` reaches (t ≤ duration, whole control periods).
-pub fn probe_times_for(scenario: &Scenario) -> Vec<f64> {
-    let period = scenario.controller.period_s;
-    PROBE_TIMES_S
-        .iter()
-        .copied()
-        .filter(|&t| {
-            let n = (t / period).round();
-            t <= scenario.simulation.duration_s && (n * period - t).abs() <= 1e-9 * t.max(period)
-        })
-        .collect()
-}
-
 fn progress_bar(duration_s: f64) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
+    if quiet() || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
     // Whole seconds of mission time; the bar's unit.
@@ -190,24 +205,25 @@ fn progress_bar(duration_s: f64) -> ProgressBar {
 
 /// `tss-sim run` with a given simulation function (tests pass a synthetic one).
 ///
-/// Loads and validates the scenario, checks the output directory, runs `simulate` with the
-/// Table-1 probe times and a progress callback, then writes every output. Nothing is created
-/// before `simulate` has succeeded.
+/// Loads and validates the scenario, prepares the output directory ([`OutputSet::prepare`]:
+/// an unusable one is a usage error, found before any work), runs `simulate` with the Table-1
+/// probe times, the output set (for files of its own) and a progress callback, then writes
+/// every output and commits the set. If `simulate` or a write fails, nothing is committed.
 pub fn run_with<E>(
     args: &RunArgs,
-    simulate: impl FnOnce(&Scenario, &[f64], &mut dyn FnMut(f64)) -> Result<History, E>,
+    simulate: impl FnOnce(&Scenario, &[f64], &mut OutputSet, &mut dyn FnMut(f64)) -> Result<History, E>,
 ) -> anyhow::Result<RunOutcome>
 where
     E: std::error::Error + Send + Sync + 'static,
 {
     let scenario = Scenario::load(&args.scenario, &args.set)?;
     let dir = output_dir(args, &scenario);
-    check_output_dir(&dir)?;
+    let mut out = OutputSet::prepare("--out", &dir, output_names())?;
 
     let probes = probe_times_for(&scenario);
     let bar = progress_bar(scenario.simulation.duration_s);
     let started = Instant::now();
-    let history = simulate(&scenario, &probes, &mut |t_s| {
+    let history = simulate(&scenario, &probes, &mut out, &mut |t_s| {
         bar.set_position(t_s.max(0.0) as u64)
     })
     .with_context(|| format!("simulating {}", args.scenario.display()));
@@ -216,17 +232,18 @@ where
     let sim_time = started.elapsed();
 
     let started = Instant::now();
-    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-    let history_csv = dir.join("history.csv");
-    write_file(&history_csv, |w| {
-        output::write_history_csv(w, &history.samples)
-    })?;
+    let mut files = Vec::new();
+    files.push(out.write("history.csv", |w| {
+        if history.elastic.is_empty() {
+            output::write_history_csv(w, &history.samples)
+        } else {
+            output::write_elastic_history_csv(w, &history.samples, &history.elastic)
+        }
+    })?);
     let table = Table1Comparison::new(&history.probes);
-    let table1_csv = dir.join("table1.csv");
-    write_file(&table1_csv, |w| table.write_csv(w))?;
-    let scenario_toml = dir.join("scenario.toml");
+    files.push(out.write("table1.csv", |w| table.write_csv(w))?);
     let resolved = toml::to_string_pretty(&scenario).context("serializing the scenario")?;
-    write_file(&scenario_toml, |w| {
+    files.push(out.write("scenario.toml", |w| {
         writeln!(
             w,
             "# The scenario as run: {} with {} override(s){}",
@@ -239,43 +256,38 @@ where
             }
         )?;
         w.write_all(resolved.as_bytes())
-    })?;
+    })?);
     let summary = summarize(&scenario, &history);
     let report = format!("{}\n{}", summary.render(), table.render());
-    let summary_txt = dir.join("summary.txt");
-    write_file(&summary_txt, |w| w.write_all(report.as_bytes()))?;
+    files.push(out.write("summary.txt", |w| w.write_all(report.as_bytes()))?);
     // The fault summary (faults.rs): printed after the report and written to faults.txt.
     let faults = crate::faults::render_fault_summary(&scenario, &history.faults);
-    write_file(&dir.join("faults.txt"), |w| w.write_all(faults.as_bytes()))?;
+    files.push(out.write("faults.txt", |w| w.write_all(faults.as_bytes()))?);
     let report = format!("{report}\n{faults}");
-    let (figures, figure_error) = match plots::write_figures(&dir, &scenario, &history) {
+    let mark = out.mark();
+    let (figures, figure_error) = match plots::write_figures(&mut out, &scenario, &history) {
         Ok(paths) => (paths, None),
-        Err(e) => (Vec::new(), Some(e)),
+        Err(e) => {
+            out.abandon_since(mark);
+            (Vec::new(), Some(e))
+        }
     };
+    // Files `simulate` staged itself (PIL: pil.txt, firmware.log) are listed too.
+    for name in [PIL_TXT, FIRMWARE_LOG] {
+        if out.is_staged(name) {
+            files.push(dir.join(name));
+        }
+    }
+    out.commit()?;
     let write_time = started.elapsed();
 
     Ok(RunOutcome {
         dir,
-        history_csv,
-        table1_csv,
-        summary_txt,
-        scenario_toml,
+        files,
         figures,
         figure_error,
         sim_time,
         write_time,
         report,
     })
-}
-
-/// Creates `path` and writes it through a buffer with `body`; an error names the file.
-pub(crate) fn write_file(
-    path: &Path,
-    body: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
-) -> anyhow::Result<()> {
-    let file = File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    let mut w = BufWriter::new(file);
-    body(&mut w)
-        .and_then(|()| w.flush())
-        .with_context(|| format!("writing {}", path.display()))
 }

@@ -1,23 +1,21 @@
 //! The closed loop: the `tss-reel` controller core (f32, exactly as on the target) flying the
 //! f64 plant of Eq. 5, synchronised on the control period.
 //!
-//! Each tick: the plant's state is sensed (through the scenario's sensor errors and injected
-//! faults, `faults::Injector`, then rounded to f32), the controller steps (or, in a dropout,
-//! steps without a sample), its rate command is held over the period (zero-order hold) and
-//! drives the reel (`reel::Reel`: ideal by default, else lagging and saturating) while RK4
-//! integrates the plant. Every tick feeds the fault summary (`History::faults`).
+//! Each tick: the plant is observed and sensed (through the scenario's sensor errors and
+//! injected faults, `faults::Injector`, then rounded to f32), the controller steps (or, in a
+//! dropout, steps without a sample), and its rate command is held over the period
+//! (zero-order hold) while the plant steps. The plant is either of `[plant] model`'s, behind
+//! the [`Plant`] trait: the rigid rod of Eq. 5 (`plant::RigidPlant`, its reel ideal or
+//! lagging and saturating) or the elastic truth model (`elastic::ElasticPlant`). Every tick
+//! feeds the fault summary (`History::faults`).
 
-use crate::faults::{Injector, Sensed, SummaryBuilder, TickRecord, Truth};
+use crate::elastic::{ElasticError, ElasticParams, ElasticPlant, InitialConditions};
+use crate::faults::{InjectionPlan, Injector, Sensed, SummaryBuilder, TickRecord, Truth};
 use crate::history::{History, PhaseLabel, Sample};
-use crate::plant::{ix, Plant, State};
-use crate::reel::{Reel, ReelSaturation};
-use crate::scenario::Scenario;
-use tss_reel::controller::{
-    Config, ConfigError, Controller, Envelope, Input, MonitorConfig, Output, Phase, Stage1Config,
-    Stage2Config,
-};
-use tss_reel::law::Gains;
-use tss_reel::mass::MassModel;
+use crate::plant::{ix, Command, Observation, Plant, RigidModel, RigidPlant, State};
+use crate::reel::{Reel, ReelDrive};
+use crate::scenario::{PlantModel, Scenario};
+use tss_reel::controller::{Config, ConfigError, Controller, Input, Output, Phase};
 use tss_reel::orbit::Orbit;
 use tss_reel::schedule::BandSchedule;
 use tss_reel::Real;
@@ -41,6 +39,9 @@ pub enum SimError {
     /// The controller in the loop failed (the processor-in-the-loop link, `crate::pil`).
     #[error("the processor-in-the-loop link failed")]
     Link(#[source] Box<dyn std::error::Error + Send + Sync>),
+    /// The elastic plant's parameters are invalid.
+    #[error("{0}")]
+    Elastic(#[from] ElasticError),
     /// The plant state stopped being finite (a physically impossible run).
     #[error("the plant state became non-finite at t = {t_s} s")]
     Diverged {
@@ -49,86 +50,22 @@ pub enum SimError {
     },
 }
 
-/// The controller configuration a scenario describes, in the controller's scalar type.
+/// The controller configuration a scenario describes, in the controller's scalar type
+/// ([`Scenario::controller_config`]), once the stage-2 start is a whole number of periods.
 pub fn controller_config<T: Real>(sc: &Scenario) -> Result<Config<T>, SimError> {
-    let f = T::from_f64;
-    let period = sc.controller.period_s;
-    let stage2_tick = ticks("stage2.start_time_s", sc.stage2.start_time_s, period)?;
-    Ok(Config {
-        period_s: f(period),
-        orbit: Orbit::elliptic(f(sc.orbit.semi_major_axis_m), f(sc.orbit.eccentricity)),
-        masses: mass_model(sc),
-        gains: Gains {
-            k1_per_s: f(sc.controller.k1_per_s),
-            k2_per_s2: f(sc.controller.k2_per_s2),
-        },
-        initial_rate_mps: f(sc.initial.length_rate_mps),
-        stage1: Stage1Config {
-            schedule: BandSchedule {
-                low_length_m: f(sc.stage1.band_start_m),
-                low_angle_rad: f(sc.stage1.deploy_angle_rad),
-                low_slope_rad_per_m: T::ZERO,
-                high_length_m: f(sc.stage1.keep_length_m),
-                high_angle_rad: T::ZERO,
-                high_slope_rad_per_m: f(sc.stage1.keep_slope_rad_per_m),
-            },
-            decay_rate_per_s: f(sc.stage1.decay_rate_per_s),
-        },
-        stage2: Stage2Config {
-            schedule: BandSchedule {
-                low_length_m: f(sc.stage2.keep_length_m),
-                low_angle_rad: T::ZERO,
-                low_slope_rad_per_m: f(sc.stage2.keep_slope_rad_per_m),
-                high_length_m: f(sc.stage2.band_start_m),
-                high_angle_rad: f(sc.stage2.retrieve_angle_rad),
-                high_slope_rad_per_m: T::ZERO,
-            },
-            slew_rate_radps: f(sc.stage2.slew_rate_radps),
-            decay_rate_per_s: f(sc.stage2.decay_rate_per_s),
-            start_tick: Some(stage2_tick),
-        },
-        keep_capture_m: f(sc.controller.keep_capture_m),
-        envelope: Envelope {
-            max_rate_mps: f(sc.envelope.max_rate_mps),
-            max_accel_mps2: f(sc.envelope.max_accel_mps2),
-            min_length_m: f(sc.envelope.min_length_m),
-            max_length_m: f(sc.envelope.max_length_m),
-        },
-        monitor: monitor_config(sc),
-    })
+    ticks(
+        "stage2.start_time_s",
+        sc.stage2.start_time_s,
+        sc.controller.period_s,
+    )?;
+    Ok(sc.controller_config())
 }
 
-/// The controller's sensor-monitor thresholds from `[monitor]`.
-pub fn monitor_config<T: Real>(sc: &Scenario) -> MonitorConfig<T> {
-    let m = &sc.monitor;
-    MonitorConfig {
-        coast_ticks: m.coast_ticks,
-        recovery_ticks: m.recovery_ticks,
-        length_jump_m: T::from_f64(m.length_jump_m),
-        alpha_jump_rad: T::from_f64(m.alpha_jump_rad),
-        stuck_ticks: m.stuck_ticks,
-        stuck_motion_rad: T::from_f64(m.stuck_motion_rad),
-        max_alpha_rate_radps: T::from_f64(m.max_alpha_rate_radps),
-        min_orbit_rate_radps: T::from_f64(m.min_orbit_rate_radps),
-        max_orbit_rate_radps: T::from_f64(m.max_orbit_rate_radps),
-        // No scenario keys yet: the controller's defaults.
-        ..MonitorConfig::default_for_period()
-    }
-}
-
-fn mass_model<T: Real>(sc: &Scenario) -> MassModel<T> {
-    MassModel {
-        main_initial_kg: T::from_f64(sc.masses.main_initial_kg),
-        sub_kg: T::from_f64(sc.masses.sub_kg),
-        tether_density_kg_per_m: T::from_f64(sc.tether.density_kg_per_m),
-    }
-}
-
-/// The plant a scenario describes.
-pub fn plant(sc: &Scenario) -> Plant {
-    Plant {
+/// The rigid plant's equations a scenario describes.
+pub fn plant(sc: &Scenario) -> RigidModel {
+    RigidModel {
         orbit: Orbit::elliptic(sc.orbit.semi_major_axis_m, sc.orbit.eccentricity),
-        masses: mass_model(sc),
+        masses: sc.mass_model(),
     }
 }
 
@@ -221,8 +158,7 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
 ) -> Result<History, SimError> {
     let period = sc.controller.period_s;
     let cfg = controller_config::<T>(sc)?;
-    let mut x = initial_state(sc, &cfg);
-    let plant = plant(sc);
+    let mut plant = flown_plant(sc, &cfg)?;
     let total = ticks("simulation.duration_s", sc.simulation.duration_s, period)?;
     let every = ticks(
         "simulation.output_interval_s",
@@ -230,34 +166,37 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
         period,
     )?
     .max(1);
+    let shape_every = if sc.plant.shape_interval_s > 0.0 {
+        let s = sc.plant.shape_interval_s;
+        Some(ticks("plant.shape_interval_s", s, period)?.max(1))
+    } else {
+        None
+    };
     let mut probes: Vec<(u32, f64)> = Vec::with_capacity(probe_times_s.len());
     for &t in probe_times_s {
         probes.push((ticks("probe time", t, period)?, t));
     }
-    let substeps = sc.simulation.substeps.max(1);
-    let h = period / f64::from(substeps);
     let progress_every = ticks("progress", 60.0, period).unwrap_or(60).max(1);
 
     let mut history = History {
-        samples: Vec::with_capacity((total / every) as usize + 2),
+        samples: Vec::new(), // grown as written: never sized from the asked duration
         probes: Vec::with_capacity(probes.len()),
         ..History::default()
     };
-    let mut injector = Injector::new(sc);
-    let mut reel = Reel::new(&sc.reel, sc.initial.length_rate_mps);
-    let ideal_reel = reel.is_ideal();
-    let mut summary = SummaryBuilder::new(period, &sc.envelope);
+    let mut injector = Injector::new(&InjectionPlan::from(sc), period);
+    let mut summary = SummaryBuilder::new(period, &sc.envelope.to_envelope());
     let mut next_probe = 0;
     for tick in 0..=total {
         let t_s = f64::from(tick) * period;
-        if !x.iter().all(|v| v.is_finite()) {
+        if !plant.is_finite() {
             return Err(SimError::Diverged { t_s });
         }
+        let seen = plant.observe(&Command::default()).sensors;
         let truth = Truth {
-            length_m: x[ix::LENGTH],
-            alpha_rad: x[ix::ALPHA],
-            alpha_rate_radps: x[ix::ALPHA_RATE],
-            orbit_rate_radps: plant.orbit_rate_radps(x[ix::THETA]),
+            length_m: seen.length_m,
+            alpha_rad: seen.alpha_rad,
+            alpha_rate_radps: seen.alpha_rate_radps,
+            orbit_rate_radps: seen.orbit_rate_radps,
         };
         let sensed = injector.sense(tick, t_s, &truth);
         let out = match sensed {
@@ -273,35 +212,38 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
             )?,
             Sensed::Missing => stepper.step(tick, None)?,
         };
-        let rate = out.rate_cmd_mps.to_f64();
-        // The tension of Eq. 5a at the start of the period: with the ideal reel l̈ is the
-        // commanded acceleration; with a real drive, its actual rate and acceleration.
-        let (tension_n, reel_sat) = if ideal_reel {
-            let accel = out.accel_cmd_mps2.to_f64();
-            (plant.tension_n(&x, rate, accel), ReelSaturation::default())
-        } else {
-            let (v, a) = (reel.rate_after(rate, 0.0), reel.accel_after(rate, 0.0));
-            (plant.tension_n(&x, v, a), reel.saturation(rate, period))
+        let command = Command {
+            rate_mps: out.rate_cmd_mps.to_f64(),
+            accel_mps2: out.accel_cmd_mps2.to_f64(),
         };
+        let obs = plant.observe(&command);
         summary.record(
             &TickRecord {
                 tick,
                 t_s,
-                length_m: x[ix::LENGTH],
-                tension_n,
+                length_m: obs.length_m,
+                tension_n: obs.tension_n,
                 missing: sensed == Sensed::Missing,
-                reel: reel_sat,
+                reel: obs.reel,
             },
             &out,
         );
         while next_probe < probes.len() && probes[next_probe].0 <= tick {
             if probes[next_probe].0 == tick {
-                history.probes.push((probes[next_probe].1, x[ix::LENGTH]));
+                history.probes.push((probes[next_probe].1, obs.length_m));
             }
             next_probe += 1;
         }
         if tick % every == 0 || tick == total {
-            history.samples.push(sample(&x, t_s, tension_n, &out));
+            history.samples.push(sample(&obs, t_s, &out));
+            if let Some(e) = obs.elastic {
+                history.elastic.push(e);
+            }
+        }
+        if shape_every.is_some_and(|n| tick % n == 0) || tick == total {
+            if let Some(nodes) = plant.shape() {
+                history.shapes.push((t_s, nodes));
+            }
         }
         if tick % progress_every == 0 {
             progress(t_s);
@@ -309,51 +251,58 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
         if tick == total {
             break;
         }
-        if ideal_reel {
-            for _ in 0..substeps {
-                x = plant.rk4_step(&x, rate, h);
-            }
-        } else {
-            for k in 0..substeps {
-                x = rk4_with_reel(&plant, &x, &reel, rate, f64::from(k) * h, h);
-            }
-            reel.advance(rate, period);
-        }
+        plant.step(&command, period);
     }
     history.faults = summary.finish();
     Ok(history)
 }
 
-/// One RK4 step of `h_s` seconds starting `t0_s` into the period, with the reel's rate v(t)
-/// under the held command (`reel` is the drive at the start of the period): each stage sees
-/// the rate at its own time, so l integrates v(t) (Simpson's rule) and Eq. 5b sees l̇ = v(t).
-fn rk4_with_reel(
-    plant: &Plant,
-    x: &State,
-    reel: &Reel,
-    command_mps: f64,
-    t0_s: f64,
-    h_s: f64,
-) -> State {
-    let v = |t: f64| reel.rate_after(command_mps, t);
-    let (v0, v1, v2) = (v(t0_s), v(t0_s + 0.5 * h_s), v(t0_s + h_s));
-    plant.rk4_step_varying(x, [v0, v1, v2], h_s)
+/// The elastic plant's initial conditions: the rigid plant's (straight at l(0), along
+/// α(0), β(0), unstretched, paying out at l̇(0)).
+pub fn elastic_initial<T: Real>(sc: &Scenario, cfg: &Config<T>) -> InitialConditions {
+    let x = initial_state(sc, cfg);
+    InitialConditions {
+        length_m: x[ix::LENGTH],
+        rate_mps: sc.initial.length_rate_mps,
+        alpha_rad: x[ix::ALPHA],
+        alpha_rate_radps: x[ix::ALPHA_RATE],
+        beta_rad: x[ix::BETA],
+        beta_rate_radps: x[ix::BETA_RATE],
+    }
 }
 
-fn sample<T: Real>(x: &State, t_s: f64, tension_n: f64, out: &Output<T>) -> Sample {
+/// The plant `[plant] model` selects, at its initial state.
+pub fn flown_plant<T: Real>(sc: &Scenario, cfg: &Config<T>) -> Result<Box<dyn Plant>, SimError> {
+    Ok(match sc.plant.model {
+        PlantModel::Rigid => Box::new(RigidPlant {
+            model: plant(sc),
+            x: initial_state(sc, cfg),
+            reel: Reel::new(&ReelDrive::from(&sc.reel), sc.initial.length_rate_mps),
+            substeps: sc.simulation.substeps.max(1),
+            locked: sc.reel.locked,
+            period_s: sc.controller.period_s,
+        }),
+        PlantModel::Elastic => Box::new(ElasticPlant::new(
+            ElasticParams::from(sc),
+            elastic_initial(sc, cfg),
+        )?),
+    })
+}
+
+fn sample<T: Real>(obs: &Observation, t_s: f64, out: &Output<T>) -> Sample {
     let rate = out.rate_cmd_mps.to_f64();
     let accel = out.accel_cmd_mps2.to_f64();
     Sample {
         t_s,
-        length_m: x[ix::LENGTH],
+        length_m: obs.length_m,
         length_rate_mps: rate,
-        alpha_rad: x[ix::ALPHA],
-        alpha_rate_radps: x[ix::ALPHA_RATE],
+        alpha_rad: obs.alpha_rad,
+        alpha_rate_radps: obs.alpha_rate_radps,
         alpha_ref_rad: out.alpha_ref_rad.to_f64(),
         delta_rad: out.delta_rad.to_f64(),
         delta_rate_radps: out.delta_rate_radps.to_f64(),
-        beta_rad: x[ix::BETA],
-        tension_n,
+        beta_rad: obs.beta_rad,
+        tension_n: obs.tension_n,
         length_accel_mps2: accel,
         law_rate_mps: out.law_rate_mps.to_f64(),
         blend_weight: out.blend_weight.to_f64(),

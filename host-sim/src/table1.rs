@@ -292,6 +292,19 @@ pub const PROBE_TIMES_S: [f64; PAPER_TABLE1_LEN] = {
     times
 };
 
+/// The Table-1 instants a run of `scenario` reaches (t ≤ duration, whole control periods).
+pub fn probe_times_for(scenario: &crate::scenario::Scenario) -> Vec<f64> {
+    let period = scenario.controller.period_s;
+    PROBE_TIMES_S
+        .iter()
+        .copied()
+        .filter(|&t| {
+            let n = (t / period).round();
+            t <= scenario.simulation.duration_s && (n * period - t).abs() <= 1e-9 * t.max(period)
+        })
+        .collect()
+}
+
 /// A probe is matched to a Table-1 instant when their times differ by at most this, s.
 pub const PROBE_TIME_TOLERANCE_S: f64 = 1e-6;
 
@@ -405,8 +418,8 @@ impl Table1Comparison {
         );
         let _ = writeln!(
             out,
-            "  {:<39}  |  stage 2 (keep at 2 km)",
-            "stage 1 (keep at 30 km)"
+            "  {:<39}  |  stage 2 (paper: keep at 2 km)",
+            "stage 1 (paper: keep at 30 km)"
         );
         let _ = writeln!(out, "  {head}  |  {head}");
         for i in 0..s1.len().max(s2.len()) {
@@ -437,7 +450,10 @@ impl Table1Comparison {
                     );
                 }
                 None => {
-                    let _ = writeln!(out, "  stage {n}: not reached by this run");
+                    let _ = writeln!(
+                        out,
+                        "  stage {n}: no comparison, the run ended before these instants"
+                    );
                 }
             }
         }
@@ -513,7 +529,10 @@ mod tests {
         assert_eq!(m1.compared, 21);
         assert_eq!(c.max_abs_difference(2), None);
         let text = c.render();
-        assert!(text.contains("stage 2: not reached by this run"), "{text}");
+        assert!(
+            text.contains("stage 2: no comparison, the run ended before these instants"),
+            "{text}"
+        );
         let mut csv = Vec::new();
         c.write_csv(&mut csv).unwrap();
         let csv = String::from_utf8(csv).unwrap();

@@ -415,3 +415,54 @@ fn bad_dispersions_shards_and_runs_are_clear_errors() {
     );
     rejected(&[sc, "--runs", "0"], &["--runs"]);
 }
+
+/// Issue 16 §5: absurd counts are refused before any work (exit 2, naming the flag and value),
+/// not a capacity-overflow panic (18 446 744 073 709 551 615 runs) or an aborted allocation
+/// (4 000 000 000 runs); `--threads` has an upper bound too.
+#[test]
+fn absurd_runs_and_threads_are_refused_before_any_work() {
+    let sc = scenario();
+    let sc = sc.to_str().unwrap();
+    for runs in ["18446744073709551615", "4000000000", "1000001"] {
+        rejected(&[sc, "--runs", runs], &["--runs", runs, "1..=1000000"]);
+    }
+    for threads in ["1025", "18446744073709551615"] {
+        rejected(
+            &[sc, "--runs", "2", "--threads", threads],
+            &["--threads", threads],
+        );
+    }
+}
+
+/// Issue 15 §5: a scenario without `[montecarlo]` dispersions used to fly N identical runs and
+/// report 100 % pass; it is an error that says what is missing.
+#[test]
+fn a_scenario_without_dispersions_is_an_error() {
+    let sc = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper.toml");
+    rejected(
+        &[sc.to_str().unwrap(), "--runs", "3"],
+        &["paper.toml", "no [[montecarlo.dispersion]]"],
+    );
+}
+
+/// Issue 16 §5: a campaign replaces the files of an earlier one in its directory, figures
+/// included: with --no-figures, the earlier campaign's figures are removed rather than left
+/// next to results they do not show; other files stay.
+#[test]
+fn a_campaign_replaces_an_earlier_campaigns_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("mc");
+    std::fs::create_dir_all(&out).unwrap();
+    for f in [
+        "mc_histograms.png",
+        "mc_scatter_keep1_max_error_m.svg",
+        "notes.md",
+    ] {
+        std::fs::write(out.join(f), "earlier").unwrap();
+    }
+    campaign(&out, 2, 7, &SHORT);
+    assert!(!out.join("mc_histograms.png").exists());
+    assert!(!out.join("mc_scatter_keep1_max_error_m.svg").exists());
+    assert!(out.join("notes.md").exists());
+    assert!(out.join("runs.csv").is_file());
+}

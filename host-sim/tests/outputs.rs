@@ -73,6 +73,23 @@ fn a_short_mission_writes_every_file() {
     assert!(stderr.is_empty(), "stderr: {stderr}");
     assert!(stdout.contains("fig4_length_tension.png"), "{stdout}");
     assert!(stdout.contains("Summary of scenario `short`"), "{stdout}");
+    // Issue 15 §5: every file written is listed, faults.txt too.
+    for f in [
+        "history.csv",
+        "table1.csv",
+        "summary.txt",
+        "faults.txt",
+        "scenario.toml",
+    ] {
+        let listed = out.join(f).display().to_string();
+        assert!(stdout.contains(&listed), "{listed} not listed: {stdout}");
+    }
+    let leftovers: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".partial"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
 
     let rows = check_outputs(&out);
     assert_eq!(rows.len(), 61, "0..600 s every 10 s");
@@ -192,7 +209,7 @@ fn synthetic_history_round_trips_through_the_outputs() {
     let history = synthetic(500);
     let expected = history.samples.clone();
     let mut probe_times = Vec::new();
-    let outcome = run_with(&args, |_, probes, progress| {
+    let outcome = run_with(&args, |_, probes, _, progress| {
         probe_times = probes.to_vec();
         progress(0.0);
         Ok::<_, std::io::Error>(history)
@@ -220,13 +237,13 @@ fn a_failed_simulation_writes_nothing() {
         set: vec![],
         pil: Default::default(),
     };
-    let e = run_with(&args, |_, _, _| {
+    let e = run_with(&args, |_, _, _, _| {
         Err::<History, _>(std::io::Error::other("diverged"))
     })
     .unwrap_err();
     assert!(format!("{e:#}").contains("diverged"));
     assert!(!out.exists());
-    assert!(!tss_sim::run_cmd::is_usage_error(&e));
+    assert!(!tss_sim::usage::is_usage_error(&e));
 }
 
 #[test]
@@ -254,4 +271,104 @@ fn without_a_font_the_other_outputs_are_written_and_the_error_names_the_package(
         assert!(out.join(f).is_file(), "{f} missing");
     }
     assert!(!out.join("fig4_length_tension.png").exists());
+}
+
+fn args_into(out: &Path) -> RunArgs {
+    RunArgs {
+        scenario: paper(),
+        out: Some(out.to_path_buf()),
+        set: vec![],
+        pil: Default::default(),
+    }
+}
+
+/// The names of the files in `dir`, sorted.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// Issue 16 §5: an output directory that cannot be written used to be found only after the
+/// whole simulation (exit 1); it is a usage error (exit 2) before the simulation starts.
+#[test]
+fn an_unwritable_output_is_found_before_the_simulation() {
+    let tmp = tempfile::tempdir().unwrap();
+    // Cannot be created, even by root.
+    let unwritable = Path::new("/proc/tss-sim-test/out");
+    // A directory where a result file goes (the rename at the end would fail).
+    let blocked = tmp.path().join("blocked");
+    std::fs::create_dir_all(blocked.join("history.csv")).unwrap();
+    for out in [unwritable, blocked.as_path()] {
+        let mut simulated = false;
+        let e = run_with(&args_into(out), |_, _, _, _| {
+            simulated = true;
+            Err::<History, _>(std::io::Error::other("not to be reached"))
+        })
+        .unwrap_err();
+        assert!(!simulated, "{}: simulated before checking", out.display());
+        assert!(tss_sim::usage::is_usage_error(&e), "{e:#}");
+        assert!(format!("{e:#}").contains("--out"), "{e:#}");
+    }
+    assert_eq!(listing(&blocked), ["history.csv"]);
+
+    let o = Command::new(BIN)
+        .args(["run", paper().to_str().unwrap(), "-o"])
+        .arg(unwritable)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+/// Issue 16 §5: a failed run leaves an earlier run's results as they were (no file of the failed
+/// run, no temporary file); a successful one replaces them and removes the files of the set it
+/// did not write (an earlier PIL run's pil.txt and firmware.log).
+#[test]
+fn a_failed_run_leaves_the_earlier_results_and_a_new_one_replaces_them_all() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("run");
+    std::fs::create_dir_all(&out).unwrap();
+    for f in [
+        "history.csv",
+        "summary.txt",
+        "pil.txt",
+        "firmware.log",
+        "notes.md",
+    ] {
+        std::fs::write(out.join(f), "earlier run").unwrap();
+    }
+    let before = listing(&out);
+    let e = run_with(&args_into(&out), |_, _, _, _| {
+        Err::<History, _>(std::io::Error::other("diverged"))
+    })
+    .unwrap_err();
+    assert!(format!("{e:#}").contains("diverged"));
+    assert_eq!(listing(&out), before);
+    assert_eq!(
+        std::fs::read_to_string(out.join("history.csv")).unwrap(),
+        "earlier run"
+    );
+
+    run_with(&args_into(&out), |_, _, _, _| {
+        Ok::<_, std::io::Error>(synthetic(50))
+    })
+    .unwrap();
+    let after = listing(&out);
+    assert!(!after.contains(&"pil.txt".to_string()), "{after:?}");
+    assert!(!after.contains(&"firmware.log".to_string()), "{after:?}");
+    assert!(after.contains(&"notes.md".to_string()), "not ours: kept");
+    assert!(after.iter().all(|n| !n.contains(".partial")), "{after:?}");
+    assert_ne!(
+        std::fs::read_to_string(out.join("history.csv")).unwrap(),
+        "earlier run"
+    );
+    check_outputs(&out);
 }

@@ -8,6 +8,10 @@
 //!   fault injected; both ends count the same faults, the tether stays inside its envelope, and
 //!   a host-linked run with sensor dropouts at exactly the ticks the firmware had no sample
 //!   computes the same commands bit for bit.
+//! - `a_lost_first_frame_does_not_stop_the_link` and
+//!   `heavy_link_faults_at_the_start_and_the_end_are_counted_exactly` (issue 16 §4): short runs
+//!   with every sample frame faulted (all four kinds, several seeds), the first and the last
+//!   frames among them: the link starts, every period flies, and both ends agree exactly.
 //!
 //! They need the firmware ELF (`cargo fw-build`, or `TSS_FIRMWARE_ELF`) and `qemu-system-arm`
 //! and `defmt-print` on PATH. Without them each test prints why and passes, unless
@@ -19,12 +23,15 @@ use std::sync::Mutex;
 
 use tss_reel::controller::{Controller, Input, Output};
 use tss_sim::history::History;
-use tss_sim::pil::{self, PilReport};
+use tss_sim::pil::{self, Injected, PilReport};
 use tss_sim::scenario::Scenario;
 use tss_sim::sim::{self, SimError, Stepper};
 
 /// One QEMU at a time: two cores, and a stalled host would make the firmware time out.
 static QEMU: Mutex<()> = Mutex::new(());
+
+/// Link seeds of the heavy-fault runs: between them they lose a first and a last frame.
+const SEEDS: [u64; 4] = [1, 2, 3, 4];
 
 /// The simulated stretch: the first 30 minutes of the paper's mission (deployment).
 const DURATION_S: &str = "simulation.duration_s=1800";
@@ -216,4 +223,80 @@ fn link_faults_are_dropouts_counted_on_both_sides() {
         );
     }
     assert_eq!(host.faults, pil_faults);
+}
+
+/// Runs `sc` in PIL and checks that every period flew and both ends agree on every count.
+fn assert_exact_accounting(sc: &Scenario, elf: &Path, name: &str) -> PilReport {
+    let (pil, report) = run_pil(sc, elf, name);
+    eprint!("{}", report.render());
+    let ticks = pil.faults.ticks;
+    assert_eq!(report.ticks, ticks, "every period flew");
+    assert_eq!(
+        report.firmware_counts(),
+        report.expected_firmware_counts(),
+        "the firmware counted what the plant injected"
+    );
+    assert!(report.consistent());
+    report
+}
+
+/// Issue 16 §4: with the first sample frame corrupted (seed 3, half the frames corrupted) the
+/// firmware used to wait for a first good frame while the plant waited for the command of tick
+/// 0: a 60 s deadlock, then "no command for tick 0".
+#[test]
+fn a_lost_first_frame_does_not_stop_the_link() {
+    let Some(elf) = firmware() else { return };
+    let _one = QEMU.lock().unwrap_or_else(|e| e.into_inner());
+    let sc = scenario(&[
+        "simulation.duration_s=5",
+        "link.seed=3",
+        "link.corrupt_prob=0.5",
+    ]);
+    let report = assert_exact_accounting(&sc, &elf, "start");
+    assert_eq!(
+        report.missing_ticks.first(),
+        Some(&0),
+        "the first frame was lost"
+    );
+    assert_eq!(report.ticks, 6);
+}
+
+/// Issue 16 §4: every sample frame meets a fault (a quarter each of dropped, corrupted,
+/// duplicated, reordered), over several seeds; among them runs whose first and whose last
+/// frames are lost. Every period flies and the end-of-run counts agree exactly (on main the
+/// gaps of frames lost after the last one that arrived were not counted).
+#[test]
+fn heavy_link_faults_at_the_start_and_the_end_are_counted_exactly() {
+    let Some(elf) = firmware() else { return };
+    let _one = QEMU.lock().unwrap_or_else(|e| e.into_inner());
+    let (mut start_lost, mut end_lost) = (false, false);
+    let mut total = Injected::default();
+    for seed in SEEDS {
+        let seed = format!("link.seed={seed}");
+        let sc = scenario(&[
+            "simulation.duration_s=8",
+            &seed,
+            "link.drop_prob=0.25",
+            "link.corrupt_prob=0.25",
+            "link.duplicate_prob=0.25",
+            "link.reorder_prob=0.25",
+        ]);
+        let report = assert_exact_accounting(&sc, &elf, &format!("heavy-{seed}"));
+        let last = report.ticks - 1;
+        start_lost |= report.missing_ticks.first() == Some(&0);
+        end_lost |= report.missing_ticks.last() == Some(&last);
+        let i = report.injected;
+        total.dropped += i.dropped;
+        total.corrupted += i.corrupted;
+        total.duplicated += i.duplicated;
+        total.reordered += i.reordered;
+    }
+    assert!(
+        start_lost && end_lost,
+        "the seeds lose a first and a last frame"
+    );
+    assert!(
+        total.dropped > 0 && total.corrupted > 0 && total.duplicated > 0 && total.reordered > 0,
+        "every kind of fault injected: {total:?}"
+    );
 }

@@ -109,11 +109,36 @@ fn a_physically_invalid_value_exits_2() {
     );
     rejected(
         &paper(),
-        &["--set", "masses.sub_kg=0", "-s", "orbit.eccentricity=1.5"],
+        &["--set", "masses.sub_kg=0", "-s", "initial.beta_rad=2"],
         &[
             "masses.sub_kg = 0 must be above 0",
-            "orbit.eccentricity = 1.5 must be in [0, 1)",
+            "initial.beta_rad = 2 must be within (−π/2, π/2)",
         ],
+    );
+    // A rule of the controller's own (it used to fail the run with exit 1).
+    rejected(
+        &paper(),
+        &["-s", "orbit.eccentricity=0.8"],
+        &["paper.toml: orbit.eccentricity = 0.8 must be in [0, 0.75)"],
+    );
+}
+
+/// Used to abort on a 48 GB allocation: now a usage error before any work.
+#[test]
+fn a_run_too_long_for_the_simulator_exits_2() {
+    rejected(
+        &paper(),
+        &["--set", "simulation.duration_s=4294967295"],
+        &["paper.toml: simulation.duration_s = 4294967295 is 4294967295 control periods, more than the simulator's 10000000"],
+    );
+}
+
+#[test]
+fn a_value_that_overflows_the_controllers_f32_exits_2() {
+    rejected(
+        &paper(),
+        &["--set", "masses.main_initial_kg=1e308"],
+        &["paper.toml: masses.main_initial_kg = 1e308 overflows the controller's f32"],
     );
 }
 

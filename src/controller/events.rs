@@ -14,7 +14,7 @@ pub const EVENT_CAPACITY: usize = 16;
 
 /// Something that happened in one step, worth telling the ground about once.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum EventKind {
     /// The input health changed.
     Health {
@@ -35,7 +35,7 @@ pub enum EventKind {
 
 /// An event and the tick it happened at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Event {
     /// The tick.
     pub tick: u32,

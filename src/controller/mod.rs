@@ -1,7 +1,7 @@
 //! The reel controller: one fixed-step [`Controller::step`] from sensed length, α, α̇ and orbit
 //! rate to a reel-rate command, through the reference schedules (Eqs. 34, 35), the implicit
-//! range-rate law (Eq. 27 + 29, SPEC §5), the commanded acceleration (Eq. 30) and the mission
-//! sequencer (SPEC §7).
+//! range-rate law (Eq. 27 + 29, docs/equations.md §5), the commanded acceleration (Eq. 30) and the mission
+//! sequencer (docs/equations.md §7).
 //!
 //! ```
 //! use tss_reel::controller::{Config, Controller, Input, Phase};
@@ -207,7 +207,7 @@ impl<T: Real> Controller<T> {
         // bad sample, and time does not move (see `clock`).
         let elapsed_ticks = match self.clock.advance(tick) {
             Ok(Elapsed::First) => {
-                // Sequence the mission: stage 1 begins with the first step (SPEC §7).
+                // Sequence the mission: stage 1 begins with the first step (docs/equations.md §7).
                 self.sequencer.begin_stage1(tick, &mut flags);
                 0
             }

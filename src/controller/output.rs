@@ -7,7 +7,7 @@ use crate::monitor::Sensor;
 
 /// Mission phase.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Phase {
     /// Stage 1, paying out.
     Deploy,
@@ -36,7 +36,7 @@ pub enum Phase {
 /// bad samples in a row reach safe hold, and so does an intermittent sensor that delivers,
 /// sustained, fewer than G good samples per bad one; recovery clears the counter.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Health {
     /// Valid samples; the law commands the reel.
     Nominal,
@@ -51,7 +51,7 @@ pub enum Health {
 
 /// Why this step's command is not the law's value.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Fault {
     /// A sample was missing or rejected.
     Sensor(Sensor),
@@ -61,7 +61,7 @@ pub enum Fault {
 
 /// Status bits reported with every command.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Flags(pub u32);
 
 impl Flags {
@@ -103,7 +103,7 @@ impl Flags {
 
 /// What one step decided, and why: the command and the parts it was made of.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Output<T> {
     /// The tick this output belongs to.
     pub tick: u32,

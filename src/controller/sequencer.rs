@@ -1,4 +1,4 @@
-//! The mission sequencer (SPEC §7): the two stages, their phases, the Eq. 29 blend each stage
+//! The mission sequencer (docs/equations.md §7): the two stages, their phases, the Eq. 29 blend each stage
 //! (or a recovery) restarts, and the reference angle α_r of each phase (Eqs. 34, 35).
 //!
 //! ```text

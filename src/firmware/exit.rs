@@ -5,8 +5,8 @@
 //! for [`success`] and 1 for [`failure`], which `scripts/qemu-run` passes on to cargo. On the
 //! flight MCU, with no debugger attached, these are where a reset into safe mode would go.
 //!
-//! Self-contained (it uses only cortex-m, cortex-m-rt, cortex-m-semihosting and defmt), so the
-//! on-target test suite includes the same file for the same fault behaviour.
+//! The handlers are linked into every program built with the `firmware` feature: the firmware,
+//! the on-target test suite and the examples end on a fault the same way.
 
 use cortex_m_rt::{exception, ExceptionFrame};
 use cortex_m_semihosting::debug::{self, EXIT_FAILURE, EXIT_SUCCESS};

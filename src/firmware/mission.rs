@@ -1,7 +1,7 @@
 //! What the firmware does on each control tick: the reel controller flying a recorded stretch
 //! of the paper's mission.
 //!
-//! The built-in test input ([`super::replay_data`]) is the first 720 s of `scenarios/paper.toml`
+//! The built-in test input ([`tss_reel::recordings::replay`]) is the first 720 s of `scenarios/paper.toml`
 //! as the reel MCU senses it, recorded from `tss-sim`, with a sensor dropout injected at ticks
 //! 400..450 (longer than the controller's 30-tick coast, so it goes Degraded → SafeHold and
 //! recovers). The replay implements the [`tss_reel::hal`] sensor traits; the reel drive is a
@@ -19,13 +19,14 @@
 //! `scripts/firmware-log`, and every logged command (and the digest of all of them) is checked
 //! bit for bit against the same core compiled for the host by `tests/firmware_replay.rs`.
 
-use super::replay_data::{
-    DROPOUT_FROM_TICK, DROPOUT_UNTIL_TICK, ORBIT_RATE_RADPS, PERIOD_S, SAMPLES,
-};
 use tss_reel::controller::{Config, Controller, Output};
 use tss_reel::hal::{
-    control_cycle, Devices, ErrorKind, ErrorType, LengthSensor, OrbitRateSource, ReelDrive, Swing,
-    SwingSensor,
+    control_cycle, Cycle, Devices, ErrorKind, ErrorType, LengthSensor, OrbitRateSource, ReelDrive,
+    Swing, SwingSensor,
+};
+use tss_reel::link::{fnv1a_f32, fnv1a_start};
+use tss_reel::recordings::replay::{
+    DROPOUT_FROM_TICK, DROPOUT_UNTIL_TICK, ORBIT_RATE_RADPS, PERIOD_S, SAMPLES,
 };
 
 /// Control period, ms: 1 s, the period of the paper's scenario and of the recording.
@@ -99,7 +100,8 @@ impl OrbitRateSource for CircularOrbit {
 
 /// The reel drive of the replay: a telemetry sink that checks and fingerprints each command.
 struct TelemetryReel {
-    /// FNV-1a over the bit patterns of all rate commands (as `tests/firmware_replay.rs`).
+    /// FNV-1a over the bit patterns of all rate commands ([`fnv1a_f32`], as the PIL link's
+    /// `Report` frame and `tests/firmware_replay.rs`).
     digest: u32,
     /// Commands received.
     count: u32,
@@ -114,10 +116,8 @@ impl ReelDrive for TelemetryReel {
         if !output.rate_cmd_mps.is_finite() {
             return Err(ErrorKind::Device);
         }
-        for b in output.rate_cmd_mps.to_bits().to_le_bytes() {
-            self.digest = (self.digest ^ u32::from(b)).wrapping_mul(0x0100_0193);
-        }
-        self.count += 1;
+        self.digest = fnv1a_f32(self.digest, output.rate_cmd_mps);
+        self.count = self.count.saturating_add(1);
         Ok(())
     }
 }
@@ -130,6 +130,9 @@ pub struct Mission {
 
 impl Mission {
     /// Sets the mission up (called once, before the first tick).
+    // No `Default`: setting up may end the run (a rejected configuration exits with failure),
+    // which a default value must not do.
+    #[allow(clippy::new_without_default)]
     pub fn new() -> Self {
         // The paper's configuration is valid by construction; a rejection would be a build
         // defect, reported on the first tick.
@@ -144,11 +147,21 @@ impl Mission {
                 swing: Replay,
                 orbit: CircularOrbit,
                 reel: TelemetryReel {
-                    digest: 0x811c_9dc5,
+                    digest: fnv1a_start(),
                     count: 0,
                 },
             },
         }
+    }
+
+    /// One control cycle: read the replay's sensors, step the controller
+    /// ([`Controller::step`], or `step_missing` in a dropout), command the reel.
+    ///
+    /// Out of line on purpose: it is the flight ELF's symbol for the control path, from which
+    /// `scripts/panic-check` proves that no panic is reachable.
+    #[inline(never)]
+    fn control(&mut self, tick: u32) -> Cycle {
+        control_cycle(&mut self.controller, tick, &mut self.devices)
     }
 
     /// One control step at tick `tick` (0 for the first).
@@ -173,7 +186,20 @@ impl Mission {
             return Flow::Finished;
         }
 
-        let cycle = control_cycle(&mut self.controller, tick, &mut self.devices);
+        let cycle = self.control(tick);
+        // In detail (`DEFMT_LOG=debug`): what this cycle sensed and what it commanded.
+        match Replay::sample(tick) {
+            Ok(&[length_m, alpha_rad, alpha_rate_radps]) => defmt::debug!(
+                "t={=u32} sensed: l={=f32} m alpha={=f32} rad alpha_rate={=f32} rad/s n={=f32} rad/s",
+                tick,
+                length_m,
+                alpha_rad,
+                alpha_rate_radps,
+                ORBIT_RATE_RADPS
+            ),
+            Err(e) => defmt::debug!("t={=u32} sensed: nothing ({})", tick, e),
+        }
+        defmt::debug!("t={=u32} output: {}", tick, self.controller.output());
         if let Some(e) = cycle.reel_error {
             defmt::error!("t={=u32} reel refused the command: {}", tick, e);
             return Flow::Failed;

@@ -47,9 +47,10 @@ use super::uart::{Uart, UartError};
 /// the wait lasts at least one full control period wherever in a period it starts.
 pub const TIMEOUT_TICKS: u32 = 2;
 
-/// Hard bound on the control periods of one PIL run: the paper's 20 h mission (72 001 ticks)
-/// with room to spare. A run still going then is a failure, never a hang.
-pub const MAX_TICKS: u32 = 200_000;
+/// Hard bound on the control periods of one PIL run ([`link::MAX_TICKS`]: the paper's 20 h
+/// mission, 72 001 ticks, with room to spare). A run still going then is a failure, never a
+/// hang.
+pub const MAX_TICKS: u32 = link::MAX_TICKS;
 
 /// Timeouts in a row after which the plant is taken to be gone: the run ends with a failure.
 pub const MAX_SILENT_PERIODS: u32 = 600;
@@ -65,7 +66,8 @@ enum Received {
     Timeout,
     /// A frame that failed its checks.
     Corrupted(LinkError),
-    /// The plant ended the run after this many periods.
+    /// The plant ended the run after this many periods (frames lost before its `End` are
+    /// counted as sequence gaps).
     End(u32),
 }
 
@@ -126,9 +128,8 @@ impl Link {
         sent
     }
 
-    /// Waits for the sample of period `awaited` (`None`: the first one), at most
-    /// [`TIMEOUT_TICKS`] SysTick periods.
-    fn receive(&mut self, awaited: Option<u32>) -> Received {
+    /// Waits for the sample of period `awaited`, at most [`TIMEOUT_TICKS`] SysTick periods.
+    fn receive(&mut self, awaited: u32) -> Received {
         let start = clock::ticks();
         for _ in 0..MAX_POLLS_PER_WAIT {
             let byte = match self.uart.try_read_byte() {
@@ -171,7 +172,10 @@ impl Link {
                         ),
                     }
                 }
-                Message::End(e) => return Received::End(e.ticks),
+                Message::End(e) => {
+                    self.gate.close(frame.seq, &mut self.counters);
+                    return Received::End(e.ticks);
+                }
                 Message::Hello(_) | Message::Command(_) | Message::Report(_) => {
                     self.counters.count_error(LinkError::WrongKind);
                     defmt::warn!(
@@ -247,19 +251,24 @@ pub fn run(_clock: ControlClock) -> ! {
         exit::failure();
     }
 
-    let mut awaited: Option<u32> = None;
+    // The plant's first sample is that of tick 0: a lost first frame is a missing sample like
+    // any other (the firmware times out and steps without it), never a wait for ever.
+    let mut awaited = 0u32;
     let mut silent = 0u32;
     let mut count = 0u32;
     let mut digest = link::fnv1a_start();
     let mut dropouts = 0u32;
     for _ in 0..MAX_TICKS {
-        let received = link.receive(awaited);
-        let (tick, status, reading) = match received {
+        let (tick, status, reading) = match link.receive(awaited) {
             Received::End(ticks) => finish(&mut link, ticks, count, digest, dropouts),
             Received::Sample(s) => {
                 silent = 0;
-                if let Some(a) = awaited.filter(|&a| s.tick > a) {
-                    defmt::warn!("t={=u32} link: jumped from awaited tick {=u32}", s.tick, a);
+                if s.tick > awaited {
+                    defmt::warn!(
+                        "t={=u32} link: jumped from awaited tick {=u32}",
+                        s.tick,
+                        awaited
+                    );
                 }
                 if s.status == SAMPLE_VALID {
                     (s.tick, SampleStatus::Fresh, Ok(s))
@@ -267,26 +276,19 @@ pub fn run(_clock: ControlClock) -> ! {
                     (s.tick, SampleStatus::NoSample, Err(ErrorKind::NoSample))
                 }
             }
-            Received::Timeout | Received::Corrupted(_) => {
+            lost @ (Received::Timeout | Received::Corrupted(_)) => {
                 silent = silent.saturating_add(1);
                 if silent > MAX_SILENT_PERIODS {
                     defmt::error!("PIL: no sample for {=u32} periods: link lost", silent);
                     log_counters(&link, count, digest, dropouts);
                     exit::failure();
                 }
-                // Before the first sample the mission has not started: nothing to step.
-                let Some(a) = awaited else {
-                    continue;
-                };
-                match received {
-                    Received::Corrupted(e) => {
-                        defmt::warn!("t={=u32} link: corrupted sample frame: {}", a, e);
-                        (a, SampleStatus::Corrupted, Err(ErrorKind::Corrupted))
-                    }
-                    _ => {
-                        defmt::warn!("t={=u32} link: no sample frame (timeout)", a);
-                        (a, SampleStatus::Timeout, Err(ErrorKind::NoSample))
-                    }
+                if let Received::Corrupted(e) = lost {
+                    defmt::warn!("t={=u32} link: corrupted sample frame: {}", awaited, e);
+                    (awaited, SampleStatus::Corrupted, Err(ErrorKind::Corrupted))
+                } else {
+                    defmt::warn!("t={=u32} link: no sample frame (timeout)", awaited);
+                    (awaited, SampleStatus::Timeout, Err(ErrorKind::NoSample))
                 }
             }
         };
@@ -313,7 +315,7 @@ pub fn run(_clock: ControlClock) -> ! {
             defmt::error!("t={=u32} the command frame could not be sent: {}", tick, e);
             exit::failure();
         }
-        awaited = Some(tick.saturating_add(1));
+        awaited = tick.saturating_add(1);
     }
     defmt::error!(
         "PIL: the plant did not end the run within {=u32} periods",

@@ -189,6 +189,8 @@ impl embedded_io::WriteReady for Uart {
 impl embedded_io::Write for Uart {
     /// Sends every byte of `buf`, each as soon as the transmit buffer has room.
     fn write(&mut self, buf: &[u8]) -> Result<usize, UartError> {
+        // In detail (`DEFMT_LOG=trace`): the PIL link writes one whole encoded frame per call.
+        defmt::trace!("uart0 tx {=usize} bytes: {=[u8]:02x}", buf.len(), buf);
         for &b in buf {
             self.wait_tx_room()?;
             self.write_reg(DATA, u32::from(b));

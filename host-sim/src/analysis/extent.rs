@@ -5,12 +5,14 @@
 //! θ grid only to draw them.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use serde::Serialize;
 use tss_reel::equilibrium::{self, ECCENTRICITY_LIMIT};
 
-use super::{create_dir, eccentricity, invalid, AnalysisCliError, OutputFormat};
+pub use super::ExtentRow;
+use super::{eccentricity, invalid, AnalysisCliError, OutputFormat};
+use crate::output::OutputSet;
 
 /// Default spacing of the e grid of Fig. 3 over [0, 0.75].
 pub const DEFAULT_ECCENTRICITY_STEP: f64 = 0.025;
@@ -38,32 +40,9 @@ pub struct ExtentArgs {
     #[arg(long, value_enum, default_value_t = OutputFormat::Text)]
     pub format: OutputFormat,
     /// Also write fig3_extent.csv, fig2_surfaces.csv and the plots (PNG and SVG) to this
-    /// directory (created if missing).
-    #[arg(long, value_name = "DIR")]
+    /// directory (created if missing; checked before any work).
+    #[arg(long, short, value_name = "DIR")]
     pub out: Option<PathBuf>,
-}
-
-/// One row of Fig. 3: the whole-orbit bounds of Eq. 13 at one e.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct ExtentRow {
-    /// e.
-    pub eccentricity: f64,
-    /// min_θ Depl(e, θ).
-    pub min_depl: f64,
-    /// θ* of min Depl, rad.
-    pub theta_star_depl_rad: f64,
-    /// θ* of min Depl, deg.
-    pub theta_star_depl_deg: f64,
-    /// max_θ Retr(e, θ) (= −min Depl).
-    pub max_retr: f64,
-    /// θ* of max Retr, rad (= −θ* of min Depl).
-    pub theta_star_retr_rad: f64,
-    /// θ* of max Retr, deg.
-    pub theta_star_retr_deg: f64,
-    /// Root-finder iterations.
-    pub iterations: u32,
-    /// Whether an equilibrium can exist at every θ for some rate (min Depl ≥ 0, i.e. e ≤ 0.75).
-    pub exists_whole_orbit: bool,
 }
 
 /// One sample of Fig. 2: Depl and Retr at (e, θ).
@@ -221,53 +200,70 @@ pub fn run_extent(args: &ExtentArgs) -> anyhow::Result<()> {
         )
         .into());
     }
-    if let Some(dir) = &args.out {
-        // Fail on an unusable output directory before printing anything.
-        create_dir(dir)?;
-    }
+    // An unusable output directory fails before anything is printed.
+    let mut out = match &args.out {
+        Some(dir) => Some(OutputSet::prepare("--out", dir, output_names())?),
+        None => None,
+    };
     let rows = extent_rows(&eccs)?;
+    let quiet = crate::usage::quiet();
+    // The table is the command's result: printed even under --quiet (which drops the list).
     match args.format {
         OutputFormat::Text => print!("{}", format_table(&rows)),
         OutputFormat::Csv => write_csv(std::io::stdout().lock(), &rows)?,
     }
-    if let Some(dir) = &args.out {
-        let written = write_outputs(dir, &eccs, &rows, args.theta_points)?;
-        // Keep stdout machine-readable in CSV mode.
-        for p in written {
-            eprintln!("wrote {}", p.display());
+    if let Some(mut out) = out.take() {
+        let written = write_outputs(&mut out, &eccs, &rows, args.theta_points)?;
+        out.commit()?;
+        if !quiet {
+            // As `run` does, on stdout; in CSV mode on stderr, so that stdout stays CSV.
+            let list: String = written
+                .iter()
+                .map(|p| format!("  {}\n", p.display()))
+                .collect();
+            match args.format {
+                OutputFormat::Text => print!("\nWritten:\n{list}"),
+                OutputFormat::Csv => eprint!("Written:\n{list}"),
+            }
         }
     }
     Ok(())
 }
 
-/// Writes the CSVs and plots of `extent` to `dir`; returns the paths written.
+/// Every file `extent --out` writes.
+pub fn output_names() -> Vec<String> {
+    let mut names = vec![EXTENT_CSV.to_string(), SURFACES_CSV.to_string()];
+    names.extend(super::plots::figure_names());
+    names
+}
+
+/// The Fig. 3 table.
+pub const EXTENT_CSV: &str = "fig3_extent.csv";
+/// The Fig. 2 samples.
+pub const SURFACES_CSV: &str = "fig2_surfaces.csv";
+
+/// Writes the CSVs and plots of `extent` into `out`; returns the paths written.
 pub fn write_outputs(
-    dir: &Path,
+    out: &mut OutputSet,
     eccs: &[f64],
     rows: &[ExtentRow],
     theta_points: usize,
-) -> Result<Vec<PathBuf>, AnalysisCliError> {
-    create_dir(dir)?;
+) -> anyhow::Result<Vec<PathBuf>> {
     let thetas = theta_grid(theta_points);
     let surfaces = surface_rows(eccs, &thetas);
     let mut written = Vec::new();
-    let extent_csv = dir.join("fig3_extent.csv");
-    write_csv_file(&extent_csv, rows)?;
-    written.push(extent_csv);
-    let surfaces_csv = dir.join("fig2_surfaces.csv");
-    write_csv_file(&surfaces_csv, &surfaces)?;
-    written.push(surfaces_csv);
-    written.extend(super::plots::write_extent_plots(dir, rows, &thetas)?);
+    written.push(write_csv_file(out, EXTENT_CSV, rows)?);
+    written.push(write_csv_file(out, SURFACES_CSV, &surfaces)?);
+    written.extend(super::plots::write_extent_plots(out, rows, &thetas)?);
     Ok(written)
 }
 
-fn write_csv_file<R: Serialize>(path: &Path, rows: &[R]) -> Result<(), AnalysisCliError> {
-    let out = |e: &dyn std::fmt::Display| AnalysisCliError::Output {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    };
-    let f = std::fs::File::create(path).map_err(|e| out(&e))?;
-    write_csv(std::io::BufWriter::new(f), rows).map_err(|e| out(&e))
+fn write_csv_file<R: Serialize>(
+    out: &mut OutputSet,
+    name: &str,
+    rows: &[R],
+) -> anyhow::Result<PathBuf> {
+    out.write(name, |w| write_csv(w, rows).map_err(std::io::Error::other))
 }
 
 #[cfg(test)]
@@ -312,6 +308,18 @@ mod tests {
         })
         .unwrap_err();
         assert!(err.to_string().starts_with("--step"), "{err}");
+    }
+
+    #[test]
+    fn family_keeps_ends_and_is_bounded() {
+        use crate::analysis::plots::{pick_family, MAX_FAMILY};
+        let eccs: Vec<f64> = (0..=30).map(|i| i as f64 * 0.025).collect();
+        let rows = extent_rows(&eccs).unwrap();
+        let f = pick_family(&rows);
+        assert_eq!(f.len(), MAX_FAMILY);
+        assert_eq!(f[0].eccentricity, 0.0);
+        assert_eq!(f.last().unwrap().eccentricity, 0.75);
+        assert_eq!(pick_family(&rows[..3]).len(), 3);
     }
 
     #[test]

@@ -9,15 +9,41 @@
 //! The numbers come from the flight crate (`tss_reel::equilibrium`, `tss_reel::stability`) in
 //! `f64`; this module only validates input, formats and draws. Every invalid input is an
 //! [`AnalysisCliError`] naming the flag, which `main` reports with exit code 2.
+//!
+//! The data of Fig. 3 ([`ExtentRow`]) is defined here, so that `extent` (the command) uses
+//! `plots` (the drawing) and not the other way round.
 
 pub mod extent;
 pub mod plots;
 pub mod stability_cmd;
 
-use std::path::PathBuf;
+use serde::Serialize;
 
 pub use extent::{run_extent, ExtentArgs};
 pub use stability_cmd::{run_stability, StabilityArgs};
+
+/// One row of Fig. 3: the whole-orbit bounds of Eq. 13 at one e.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ExtentRow {
+    /// e.
+    pub eccentricity: f64,
+    /// min_θ Depl(e, θ).
+    pub min_depl: f64,
+    /// θ* of min Depl, rad.
+    pub theta_star_depl_rad: f64,
+    /// θ* of min Depl, deg.
+    pub theta_star_depl_deg: f64,
+    /// max_θ Retr(e, θ) (= −min Depl).
+    pub max_retr: f64,
+    /// θ* of max Retr, rad (= −θ* of min Depl).
+    pub theta_star_retr_rad: f64,
+    /// θ* of max Retr, deg.
+    pub theta_star_retr_deg: f64,
+    /// Root-finder iterations.
+    pub iterations: u32,
+    /// Whether an equilibrium can exist at every θ for some rate (min Depl ≥ 0, i.e. e ≤ 0.75).
+    pub exists_whole_orbit: bool,
+}
 
 /// How a subcommand prints its result on stdout.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -29,8 +55,8 @@ pub enum OutputFormat {
     Csv,
 }
 
-/// An error of the analysis subcommands: bad input (naming the flag) or an output that could
-/// not be written. All of them exit with code 2.
+/// A bad input of the analysis subcommands, naming the flag (exit code 2; an unusable output
+/// directory is a [`crate::usage::UsageError`]).
 #[derive(Debug, thiserror::Error)]
 pub enum AnalysisCliError {
     /// A flag's value is impossible.
@@ -39,14 +65,6 @@ pub enum AnalysisCliError {
         /// The flag, e.g. `--length-m`.
         flag: &'static str,
         /// What is wrong with its value.
-        message: String,
-    },
-    /// A file or directory could not be written.
-    #[error("cannot write {}: {message}", path.display())]
-    Output {
-        /// The path at fault.
-        path: PathBuf,
-        /// Why.
         message: String,
     },
 }
@@ -92,12 +110,4 @@ pub(crate) fn eccentricity(flag: &'static str, e: f64) -> Result<f64, AnalysisCl
             format!("eccentricity must be in [0, 1) (got {e})"),
         ))
     }
-}
-
-/// Creates `dir` (and parents) for output.
-pub(crate) fn create_dir(dir: &std::path::Path) -> Result<(), AnalysisCliError> {
-    std::fs::create_dir_all(dir).map_err(|e| AnalysisCliError::Output {
-        path: dir.to_path_buf(),
-        message: e.to_string(),
-    })
 }

@@ -4,13 +4,14 @@
 //! Fig. 2 of the paper is a pair of 3-D surfaces; a family of curves, one per e, shows the same
 //! data more readably, with each curve's extremum θ* marked.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::extent::ExtentRow;
-use super::AnalysisCliError;
+use super::ExtentRow;
+use crate::output::OutputSet;
+use crate::plots::{draw_error, png_and_svg, write_png_and_svg, FONT};
 
 /// Pixel size of Fig. 3 (two panels side by side).
 pub const FIG3_SIZE_PX: (u32, u32) = (1400, 620);
@@ -23,7 +24,6 @@ pub const FIG2_STEM: &str = "fig2_depl_retr";
 /// Most curves in the Fig. 2 family (picked evenly from the e values).
 pub const MAX_FAMILY: usize = 7;
 
-const FONT: &str = "sans-serif";
 const DEPL_COLOR: RGBColor = RGBColor(0x1f, 0x77, 0xb4);
 const RETR_COLOR: RGBColor = RGBColor(0xd6, 0x27, 0x28);
 const PALETTE: [RGBColor; MAX_FAMILY] = [
@@ -38,22 +38,29 @@ const PALETTE: [RGBColor; MAX_FAMILY] = [
 
 type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
 
-/// Writes Fig. 3 and Fig. 2 to `dir` as PNG and SVG; returns the paths written.
+/// The file names of the figures.
+pub fn figure_names() -> Vec<String> {
+    [FIG3_STEM, FIG2_STEM]
+        .iter()
+        .flat_map(|s| png_and_svg(s))
+        .collect()
+}
+
+/// Writes Fig. 3 and Fig. 2 into `out` as PNG and SVG; returns the paths written.
 pub fn write_extent_plots(
-    dir: &Path,
+    out: &mut OutputSet,
     rows: &[ExtentRow],
     thetas: &[f64],
-) -> Result<Vec<PathBuf>, AnalysisCliError> {
+) -> anyhow::Result<Vec<PathBuf>> {
+    crate::plots::check_font()?;
     let family = pick_family(rows);
-    let mut written = Vec::new();
-    for ext in ["png", "svg"] {
-        let path = dir.join(format!("{FIG3_STEM}.{ext}"));
-        render(&path, FIG3_SIZE_PX, &Figure::Extent(rows))?;
-        written.push(path);
-        let path = dir.join(format!("{FIG2_STEM}.{ext}"));
-        render(&path, FIG2_SIZE_PX, &Figure::Surfaces(&family, thetas))?;
-        written.push(path);
-    }
+    let mut written = write_png_and_svg(out, FIG3_STEM, FIG3_SIZE_PX, &Figure::Extent(rows))?;
+    written.extend(write_png_and_svg(
+        out,
+        FIG2_STEM,
+        FIG2_SIZE_PX,
+        &Figure::Surfaces(&family, thetas),
+    )?);
     Ok(written)
 }
 
@@ -65,30 +72,13 @@ enum Figure<'a> {
     Surfaces(&'a [ExtentRow], &'a [f64]),
 }
 
-fn draw_figure<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    fig: &Figure<'_>,
-) -> DrawResult<DB> {
-    match fig {
-        Figure::Extent(rows) => draw_fig3(root, rows),
-        Figure::Surfaces(family, thetas) => draw_fig2(root, family, thetas),
-    }
-}
-
-/// Draws with the backend chosen by the extension (`.svg` or bitmap), and presents the file.
-fn render(path: &Path, size: (u32, u32), fig: &Figure<'_>) -> Result<(), AnalysisCliError> {
-    let fail = |e: &dyn std::fmt::Display| AnalysisCliError::Output {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    };
-    if path.extension().is_some_and(|e| e == "svg") {
-        let root = SVGBackend::new(path, size).into_drawing_area();
-        draw_figure(&root, fig).map_err(|e| fail(&e))?;
-        root.present().map_err(|e| fail(&e))
-    } else {
-        let root = BitMapBackend::new(path, size).into_drawing_area();
-        draw_figure(&root, fig).map_err(|e| fail(&e))?;
-        root.present().map_err(|e| fail(&e))
+impl crate::plots::Figure for Figure<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()> {
+        match self {
+            Figure::Extent(rows) => draw_fig3(root, rows),
+            Figure::Surfaces(family, thetas) => draw_fig2(root, family, thetas),
+        }
+        .map_err(draw_error)
     }
 }
 
@@ -304,21 +294,4 @@ fn draw_fig2<DB: DrawingBackend>(
             .draw()?;
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::analysis::extent::extent_rows;
-
-    #[test]
-    fn family_keeps_ends_and_is_bounded() {
-        let eccs: Vec<f64> = (0..=30).map(|i| i as f64 * 0.025).collect();
-        let rows = extent_rows(&eccs).unwrap();
-        let f = pick_family(&rows);
-        assert_eq!(f.len(), MAX_FAMILY);
-        assert_eq!(f[0].eccentricity, 0.0);
-        assert_eq!(f.last().unwrap().eccentricity, 0.75);
-        assert_eq!(pick_family(&rows[..3]).len(), 3);
-    }
 }

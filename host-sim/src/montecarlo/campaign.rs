@@ -5,8 +5,8 @@ use rayon::prelude::*;
 use crate::faults::Pcg32;
 use crate::history::History;
 use crate::report::summarize;
-use crate::run_cmd::probe_times_for;
 use crate::scenario::Scenario;
+use crate::table1::probe_times_for;
 use crate::table1::Table1Comparison;
 
 use super::{nominal_in, Distribution, MonteCarloSection};

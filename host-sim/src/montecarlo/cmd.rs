@@ -19,29 +19,38 @@ use serde::{Deserialize, Serialize};
 use super::campaign::{Campaign, RunRecord};
 use super::stats::{render, CampaignInfo, Shard};
 use super::{plots, table};
-use crate::run_cmd::{check_output_dir, write_file, UsageError};
+use crate::output::{check_output_dir, OutputSet};
 use crate::scenario::Scenario;
+use crate::usage::{quiet, UsageError};
+
+/// Largest `--runs`: a million runs (each run's record stays in memory until the campaign's
+/// files are written; about 0.05 s of computing each).
+pub const MAX_RUNS: u64 = 1_000_000;
+
+/// Largest `--threads`: far above any machine's cores, below any operating system's limit.
+pub const MAX_THREADS: usize = 1024;
 
 /// Arguments of `tss-sim montecarlo`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct MonteCarloArgs {
     /// Scenario file (TOML) with a `[montecarlo]` section, e.g. scenarios/paper-montecarlo.toml.
     pub scenario: PathBuf,
-    /// Number of runs of the whole campaign.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    /// Number of runs of the whole campaign (1 to 1 000 000).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=MAX_RUNS))]
     pub runs: u64,
     /// Seed of the campaign: run i depends on (seed, i) only.
     #[arg(long, value_name = "S", default_value_t = 0)]
     pub seed: u64,
-    /// Output directory (created if needed; files in it are overwritten).
+    /// Output directory (created if needed; the files of an earlier campaign in it are
+    /// replaced).
     #[arg(long, short, value_name = "DIR")]
     pub out: PathBuf,
     /// Fly only shard K of N: the runs i with i mod N = K − 1 (merge the shards' directories
     /// with `tss-sim merge`).
     #[arg(long, value_name = "K/N", value_parser = Shard::parse)]
     pub shard: Option<Shard>,
-    /// Worker threads (0: one per core). The results do not depend on it.
-    #[arg(long, value_name = "T", default_value_t = 0)]
+    /// Worker threads (0: one per core; at most 1024). The results do not depend on it.
+    #[arg(long, value_name = "T", default_value_t = 0, value_parser = threads_in_range)]
     pub threads: usize,
     /// Do not draw the figures (e.g. for shards: `merge` draws them).
     #[arg(long)]
@@ -52,13 +61,25 @@ pub struct MonteCarloArgs {
     pub set: Vec<String>,
 }
 
+/// Parses `--threads`: 0 to [`MAX_THREADS`].
+fn threads_in_range(text: &str) -> Result<usize, String> {
+    let n: usize = text
+        .parse()
+        .map_err(|_| format!("`{text}` is not a whole number"))?;
+    if n > MAX_THREADS {
+        return Err(format!("{n} is not in 0..={MAX_THREADS}"));
+    }
+    Ok(n)
+}
+
 /// Arguments of `tss-sim merge`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct MergeArgs {
     /// Output directories of `tss-sim montecarlo --shard K/N`, one per shard (any order).
     #[arg(required = true, value_name = "SHARD_DIR")]
     pub dirs: Vec<PathBuf>,
-    /// Output directory of the merged campaign.
+    /// Output directory of the merged campaign (created if needed; the files of an earlier
+    /// campaign in it are replaced).
     #[arg(long, short, value_name = "DIR")]
     pub out: PathBuf,
     /// Do not draw the figures.
@@ -112,8 +133,17 @@ pub const CAMPAIGN_TOML: &str = "campaign.toml";
 /// The scenario as loaded.
 pub const SCENARIO_TOML: &str = "scenario.toml";
 
+/// Every file `montecarlo` and `merge` may write into their output directory.
+pub fn output_names() -> Vec<String> {
+    let mut names: Vec<String> = [RUNS_CSV, SUMMARY_TXT, CAMPAIGN_TOML, SCENARIO_TOML]
+        .map(String::from)
+        .to_vec();
+    names.extend(plots::figure_names());
+    names
+}
+
 fn progress_bar(runs: u64) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
+    if quiet() || !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::new(runs);
@@ -128,7 +158,16 @@ fn progress_bar(runs: u64) -> ProgressBar {
 /// `tss-sim montecarlo`.
 pub fn montecarlo(args: &MonteCarloArgs) -> anyhow::Result<()> {
     let scenario = Scenario::load(&args.scenario, &args.set)?;
-    check_output_dir(&args.out)?;
+    if scenario.montecarlo.dispersion.is_empty() {
+        return Err(UsageError(format!(
+            "{}: no [[montecarlo.dispersion]] in the scenario: nothing would vary between runs \
+             (each would fly the nominal scenario); add the dispersed fields, as \
+             scenarios/paper-montecarlo.toml does",
+            args.scenario.display()
+        ))
+        .into());
+    }
+    check_output_dir("--out", &args.out)?;
     let shard = args.shard.unwrap_or(Shard::WHOLE);
     if shard.count > args.runs {
         return Err(UsageError(format!(
@@ -137,6 +176,7 @@ pub fn montecarlo(args: &MonteCarloArgs) -> anyhow::Result<()> {
         ))
         .into());
     }
+    let mut out = OutputSet::prepare("--out", &args.out, output_names())?;
     let manifest = Manifest {
         tss_sim_version: env!("CARGO_PKG_VERSION").to_string(),
         scenario_file: args.scenario.display().to_string(),
@@ -162,43 +202,45 @@ pub fn montecarlo(args: &MonteCarloArgs) -> anyhow::Result<()> {
     let records = records?;
     let elapsed = started.elapsed().as_secs_f64();
     let (report, figures) = write_outputs(
-        &args.out,
+        &mut out,
         &campaign.scenario,
         &manifest,
         shard,
         &records,
         !args.no_figures,
     )?;
-    print!("{report}");
-    println!(
-        "\nFlew {} runs in {elapsed:.2} s on {threads} thread(s) ({:.1} ms per run per thread); \
-         outputs in {}",
-        records.len(),
-        1e3 * elapsed * threads as f64 / records.len().max(1) as f64,
-        args.out.display()
-    );
+    out.commit()?;
+    if !quiet() {
+        print!("{report}");
+        println!(
+            "\nFlew {} runs in {elapsed:.2} s on {threads} thread(s) ({:.1} ms per run per \
+             thread); outputs in {}",
+            records.len(),
+            1e3 * elapsed * threads as f64 / records.len().max(1) as f64,
+            args.out.display()
+        );
+    }
     figures
 }
 
-/// Writes every output of `records` (sorted by run index) to `dir`; returns the summary text
+/// Writes every output of `records` (sorted by run index) into `out`; returns the summary text
 /// and the outcome of drawing the figures, if `draw_figures` (the other files are written
 /// regardless).
 fn write_outputs(
-    dir: &Path,
+    out: &mut OutputSet,
     sc: &Scenario,
     manifest: &Manifest,
     shard: Shard,
     records: &[RunRecord],
     draw_figures: bool,
 ) -> anyhow::Result<(String, anyhow::Result<()>)> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let fields: Vec<&str> = sc
         .montecarlo
         .dispersion
         .iter()
         .map(|d| d.field.as_str())
         .collect();
-    write_file(&dir.join(RUNS_CSV), |w| {
+    out.write(RUNS_CSV, |w| {
         table::write_runs(w, &fields, records).map_err(std::io::Error::other)
     })?;
     let seed: u64 = manifest.seed.parse().context("the manifest's seed")?;
@@ -210,9 +252,9 @@ fn write_outputs(
         shard,
     };
     let summary = render(&info, records);
-    write_file(&dir.join(SUMMARY_TXT), |w| w.write_all(summary.as_bytes()))?;
+    out.write(SUMMARY_TXT, |w| w.write_all(summary.as_bytes()))?;
     let text = toml::to_string_pretty(manifest).context("serializing the manifest")?;
-    write_file(&dir.join(CAMPAIGN_TOML), |w| {
+    out.write(CAMPAIGN_TOML, |w| {
         writeln!(
             w,
             "# A tss-sim Monte Carlo campaign (tss-sim montecarlo / merge)"
@@ -220,7 +262,7 @@ fn write_outputs(
         w.write_all(text.as_bytes())
     })?;
     let resolved = toml::to_string_pretty(sc).context("serializing the scenario")?;
-    write_file(&dir.join(SCENARIO_TOML), |w| {
+    out.write(SCENARIO_TOML, |w| {
         writeln!(
             w,
             "# The scenario as loaded: {} with {} override(s)",
@@ -229,10 +271,14 @@ fn write_outputs(
         )?;
         w.write_all(resolved.as_bytes())
     })?;
+    let mark = out.mark();
     let figures = if draw_figures {
-        plots::write_figures(dir, sc, &fields, records)
+        plots::write_figures(out, sc, &fields, records)
             .map(|_| ())
-            .map_err(|e| e.context("the figures were not drawn (every other output was written)"))
+            .map_err(|e| {
+                out.abandon_since(mark);
+                e.context("the figures were not drawn (every other output was written)")
+            })
     } else {
         Ok(())
     };
@@ -396,7 +442,7 @@ pub fn merge(args: &MergeArgs) -> anyhow::Result<()> {
             )));
         }
     }
-    check_output_dir(&args.out)?;
+    let mut out = OutputSet::prepare("--out", &args.out, output_names())?;
     let mut records: Vec<RunRecord> = shards
         .iter()
         .flat_map(|s| s.records.iter().cloned())
@@ -408,18 +454,21 @@ pub fn merge(args: &MergeArgs) -> anyhow::Result<()> {
         ..f.clone()
     };
     let (report, figures) = write_outputs(
-        &args.out,
+        &mut out,
         &first.scenario,
         &manifest,
         Shard::WHOLE,
         &records,
         !args.no_figures,
     )?;
-    print!("{report}");
-    println!(
-        "\nMerged {count} shards ({} runs) into {}",
-        records.len(),
-        args.out.display()
-    );
+    out.commit()?;
+    if !quiet() {
+        print!("{report}");
+        println!(
+            "\nMerged {count} shards ({} runs) into {}",
+            records.len(),
+            args.out.display()
+        );
+    }
     figures
 }

@@ -2,18 +2,16 @@
 //! outcomes against each dispersed input. Passing runs are blue, failing runs red; a declared
 //! criterion's limit is a dashed line.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::{anyhow, Context};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::campaign::{Metric, RunRecord};
 use super::stats::sig;
+use crate::output::OutputSet;
+use crate::plots::{draw_error as err, png_and_svg, write_png_and_svg, Figure, FONT};
 use crate::scenario::Scenario;
-
-/// Font family for all text (as the mission figures).
-const FONT: &str = "sans-serif";
 /// Bins per histogram.
 pub const HISTOGRAM_BINS: usize = 30;
 /// Panels per row of the scatter figures.
@@ -90,18 +88,27 @@ struct Inputs<'a> {
     title: String,
 }
 
-/// One figure.
+/// One figure of the campaign.
 #[derive(Clone, Copy)]
-enum Figure {
+enum Kind {
     /// The outcomes' histograms.
     Histograms,
     /// One outcome against every dispersed input.
     Scatter(Metric),
 }
 
-/// Writes every figure to `dir`; returns the paths written.
+/// The file names of every figure a campaign may draw.
+pub fn figure_names() -> Vec<String> {
+    let mut names = png_and_svg("mc_histograms").to_vec();
+    for m in SCATTER_METRICS {
+        names.extend(png_and_svg(&format!("mc_scatter_{}", m.name())));
+    }
+    names
+}
+
+/// Writes every figure into `out`; returns the paths written.
 pub fn write_figures(
-    dir: &Path,
+    out: &mut OutputSet,
     sc: &Scenario,
     fields: &[&str],
     records: &[RunRecord],
@@ -115,69 +122,35 @@ pub fn write_figures(
     };
     let mut written = Vec::new();
     let rows = HISTOGRAM_METRICS.len().div_ceil(2) as u32;
-    written.extend(both(
-        dir,
+    written.extend(write_png_and_svg(
+        out,
         "mc_histograms",
         (1400, 60 + 320 * rows),
-        &cx,
-        Figure::Histograms,
+        &(&cx, Kind::Histograms),
     )?);
     if !fields.is_empty() {
         let rows = fields.len().div_ceil(SCATTER_COLUMNS) as u32;
         for m in SCATTER_METRICS {
             let stem = format!("mc_scatter_{}", m.name());
-            written.extend(both(
-                dir,
+            written.extend(write_png_and_svg(
+                out,
                 &stem,
                 (1500, 60 + 360 * rows),
-                &cx,
-                Figure::Scatter(m),
+                &(&cx, Kind::Scatter(m)),
             )?);
         }
     }
     Ok(written)
 }
 
-/// Draws `figure` into `<stem>.png` and `<stem>.svg`.
-fn both(
-    dir: &Path,
-    stem: &str,
-    size: (u32, u32),
-    cx: &Inputs<'_>,
-    figure: Figure,
-) -> anyhow::Result<Vec<PathBuf>> {
-    let png = dir.join(format!("{stem}.png"));
-    {
-        let root = BitMapBackend::new(&png, size).into_drawing_area();
-        draw(&root, cx, figure).with_context(|| format!("drawing {}", png.display()))?;
-        root.present()
-            .map_err(|e| anyhow!("{e}"))
-            .with_context(|| format!("writing {}", png.display()))?;
+impl Figure for (&Inputs<'_>, Kind) {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()> {
+        let (cx, kind) = *self;
+        match kind {
+            Kind::Histograms => histograms(root, cx.sc, cx.records, &cx.title),
+            Kind::Scatter(m) => scatter(root, cx.sc, cx.fields, cx.records, m, &cx.title),
+        }
     }
-    let svg = dir.join(format!("{stem}.svg"));
-    {
-        let root = SVGBackend::new(&svg, size).into_drawing_area();
-        draw(&root, cx, figure).with_context(|| format!("drawing {}", svg.display()))?;
-        root.present()
-            .map_err(|e| anyhow!("{e}"))
-            .with_context(|| format!("writing {}", svg.display()))?;
-    }
-    Ok(vec![png, svg])
-}
-
-fn draw<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    cx: &Inputs<'_>,
-    figure: Figure,
-) -> anyhow::Result<()> {
-    match figure {
-        Figure::Histograms => histograms(root, cx.sc, cx.records, &cx.title),
-        Figure::Scatter(m) => scatter(root, cx.sc, cx.fields, cx.records, m, &cx.title),
-    }
-}
-
-fn err<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> anyhow::Error {
-    anyhow!("{e}")
 }
 
 fn histograms<DB: DrawingBackend>(

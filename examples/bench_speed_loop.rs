@@ -1,0 +1,443 @@
+//! # bench_speed_loop: instructions per inner speed-loop step on the Cortex-M4F (QEMU)
+//!
+//! Flies `tss_reel::reel_drive::SpeedLoop` (the example reel, 1 kHz) against a small drum
+//! model and prints, with defmt, how many instructions one [`SpeedLoop::step`] takes (median,
+//! 99th percentile, worst, per brake state) against issue 19's budget of 200, and what a
+//! [`SpeedLoop::set_command`] (once a law period) and a [`SpeedLoop::paid_out_m`] (telemetry)
+//! cost. The inputs visit every branch of the step:
+//!
+//! 1. `mission`: brake release, the law's 0.5 m/s² ramp to 5 m/s, a hold, a stop and the
+//!    brake engaging at rest (20 000 ticks);
+//! 2. `faults`: a saturated 0.5 → 10 m/s step, a one-tick encoder jump, missing counts, bad
+//!    tension readings, a non-finite command, a jammed drum until the stall trip, a cleared
+//!    trip, a counter that lost counts for good until the encoder trip.
+//!
+//! Run it (after `scripts/setup`) with
+//!
+//! ```text
+//! cargo build --profile firmware --target thumbv7em-none-eabihf --features firmware --example bench_speed_loop
+//! TSS_QEMU_ICOUNT='shift=0,align=off,sleep=off' TSS_LOG_FORMAT='{L} {s}' \
+//!   scripts/qemu-run target/thumbv7em-none-eabihf/firmware/examples/bench_speed_loop
+//! ```
+//!
+//! Instructions are counted as in `examples/bench_step.rs` (whose module docs explain it):
+//! QEMU's `-icount shift=0` makes one instruction one ns of virtual time, SysTick runs at 25 MHz
+//! (40 instructions a count, checked at start against a delay loop of known length), each
+//! measurement is `K` calls on `K` copies of the state behind `black_box`, the timing loop's
+//! own cost subtracted. The meter is a copy of that file's (an example cannot import another's
+//! items). The figures are instructions, not cycles (a VDIV takes 14 cycles on silicon).
+//!
+//! On the host this file compiles to an empty program.
+#![no_std]
+#![no_main]
+#![deny(unsafe_code)]
+
+use tss_reel::firmware::exit;
+
+mod bench {
+    use core::hint::black_box;
+    use cortex_m::peripheral::{syst::SystClkSource, SYST};
+    use tss_reel::reel_drive::{Brake, DriveConfig, DriveInput, RateCommand, SpeedLoop};
+
+    /// Copies of the state each measurement runs on; the result is divided by this.
+    pub const K: usize = 16;
+    /// Instructions per SysTick count: 25 MHz processor clock, 1 ns per instruction.
+    pub const INSTRUCTIONS_PER_COUNT: u32 = 40;
+    const RELOAD: u32 = 0x00FF_FFFF;
+    /// Issue 19's budget for one inner step, checked against the worst case.
+    pub const BUDGET_INSTRUCTIONS: u32 = 200;
+
+    /// The free-running SysTick (no interrupt), counting processor clocks.
+    pub struct Meter {
+        _syst: SYST,
+        overhead_instructions: u32,
+    }
+
+    impl Meter {
+        /// Starts SysTick on the processor clock and calibrates the loop overhead.
+        pub fn start(mut syst: SYST) -> Self {
+            syst.disable_interrupt();
+            syst.set_clock_source(SystClkSource::Core);
+            syst.set_reload(RELOAD);
+            syst.clear_current();
+            syst.enable_counter();
+            let mut m = Self {
+                _syst: syst,
+                overhead_instructions: 0,
+            };
+            let mut empty = [0_u32; K];
+            let mut least = u32::MAX;
+            for _ in 0..8 {
+                least = least.min(m.raw(&mut empty, |_| ()));
+            }
+            m.overhead_instructions = least;
+            m
+        }
+
+        pub fn overhead(&self) -> u32 {
+            self.overhead_instructions
+        }
+
+        #[inline(always)]
+        fn counts(start: u32, end: u32) -> u32 {
+            start.wrapping_sub(end) & RELOAD
+        }
+
+        #[inline(never)]
+        fn raw<S, R>(&self, states: &mut [S; K], mut f: impl FnMut(&mut S) -> R) -> u32 {
+            let t0 = SYST::get_current();
+            for s in states.iter_mut() {
+                let r = f(black_box(s));
+                black_box(&r);
+            }
+            let t1 = SYST::get_current();
+            Self::counts(t0, t1) * INSTRUCTIONS_PER_COUNT
+        }
+
+        /// Instructions of one call of `f`: `K` calls on `K` copies, loop subtracted, ÷ `K`.
+        pub fn per_call<S, R>(&self, states: &mut [S; K], f: impl FnMut(&mut S) -> R) -> u32 {
+            let total = self
+                .raw(states, f)
+                .saturating_sub(self.overhead_instructions);
+            (total + K as u32 / 2) / K as u32
+        }
+
+        /// Instructions around `asm::delay(n)`: 2n + 2 instructions plus the reads.
+        pub fn instructions_of_delay(&self, n: u32) -> u32 {
+            let t0 = SYST::get_current();
+            cortex_m::asm::delay(n);
+            let t1 = SYST::get_current();
+            Self::counts(t0, t1) * INSTRUCTIONS_PER_COUNT
+        }
+    }
+
+    /// Median, p99, worst and mean of per-step counts (exact below `BINS`).
+    pub struct Stats<const BINS: usize> {
+        hist: [u32; BINS],
+        pub n: u32,
+        sum: u64,
+        pub max: (u32, u32),
+    }
+
+    impl<const BINS: usize> Stats<BINS> {
+        pub const fn new() -> Self {
+            Self {
+                hist: [0; BINS],
+                n: 0,
+                sum: 0,
+                max: (0, 0),
+            }
+        }
+
+        pub fn add(&mut self, v: u32, tick: u32) {
+            self.hist[(v as usize).min(BINS - 1)] += 1;
+            self.n += 1;
+            self.sum += u64::from(v);
+            if v > self.max.0 || self.n == 1 {
+                self.max = (v, tick);
+            }
+        }
+
+        pub fn quantile(&self, per_mille: u32) -> u32 {
+            let need = (u64::from(self.n) * u64::from(per_mille))
+                .div_ceil(1000)
+                .max(1);
+            let mut acc = 0_u64;
+            for (v, &c) in self.hist.iter().enumerate() {
+                acc += u64::from(c);
+                if acc >= need {
+                    return v as u32;
+                }
+            }
+            BINS as u32 - 1
+        }
+
+        pub fn mean(&self) -> u32 {
+            if self.n == 0 {
+                0
+            } else {
+                (self.sum / u64::from(self.n)) as u32
+            }
+        }
+    }
+
+    /// The test drum of `tests/reel_drive.rs`, in f32 with an f64 angle (outside the timing):
+    /// J 10 % and friction 20/25 % above the loop's model, 20 N of tension.
+    struct Drum {
+        rate_radps: f32,
+        angle_counts: f64,
+        jammed: bool,
+    }
+
+    const COUNTS_PER_RAD: f64 = 40_960.0 / core::f64::consts::TAU;
+    const DT_S: f32 = 1e-3;
+
+    impl Drum {
+        fn advance(&mut self, duty: f32, released: bool, tension_n: f32) {
+            if !released || self.jammed {
+                self.rate_radps = 0.0;
+                return;
+            }
+            let w = self.rate_radps;
+            let drive = 5.0 * duty + 0.1 * tension_n - 0.012 * w;
+            let next = if w == 0.0 && libm::fabsf(drive) <= 0.25 {
+                0.0
+            } else {
+                let sign = if w != 0.0 { w } else { drive };
+                let coulomb = if sign > 0.0 { 0.25 } else { -0.25 };
+                let n = w + (drive - coulomb) / 0.055 * DT_S;
+                if w != 0.0 && (n > 0.0) != (w > 0.0) {
+                    0.0
+                } else {
+                    n
+                }
+            };
+            self.angle_counts += f64::from(0.5 * (w + next) * DT_S) * COUNTS_PER_RAD;
+            self.rate_radps = next;
+        }
+
+        fn raw_count(&self) -> u32 {
+            (libm::floor(self.angle_counts) as i64 as u32) & 0xFFFF
+        }
+    }
+
+    /// Per-brake-state worst and mean.
+    #[derive(Clone, Copy)]
+    struct StateStats {
+        n: u32,
+        sum: u64,
+        max: u32,
+    }
+
+    /// Everything measured over one scenario.
+    pub struct Run {
+        pub step: Stats<1024>,
+        states: [StateStats; 4],
+        pub command: Stats<1024>,
+    }
+
+    const STATES: [&str; 4] = ["Engaged", "Releasing", "Released", "Tripped"];
+
+    fn state_index(b: Brake) -> usize {
+        match b {
+            Brake::Engaged => 0,
+            Brake::Releasing { .. } => 1,
+            Brake::Released { .. } => 2,
+            Brake::Tripped(_) => 3,
+        }
+    }
+
+    /// What a scenario does at one tick besides stepping.
+    pub enum Action {
+        None,
+        Command(f32, f32),
+        Jam,
+        ClearTrip,
+    }
+
+    /// What a scenario feeds the loop at one tick: the action, and how the readings are spoiled.
+    pub struct Tick {
+        pub action: Action,
+        pub count_offset: u32,
+        pub count_missing: bool,
+        pub tension_n: Option<f32>,
+    }
+
+    /// Flies a fresh speed loop over `ticks` ticks of `scenario`, timing every step and command.
+    fn run(m: &Meter, r: &mut Run, ticks: u32, mut scenario: impl FnMut(u32) -> Tick) {
+        let Ok(mut drive) = SpeedLoop::new(DriveConfig::example()) else {
+            defmt::error!("the example drive configuration was rejected");
+            crate::exit::failure();
+        };
+        let mut drum = Drum {
+            rate_radps: 0.0,
+            angle_counts: 0.0,
+            jammed: false,
+        };
+        for tick in 0..ticks {
+            let t = scenario(tick);
+            match t.action {
+                Action::None => {}
+                Action::Command(rate_mps, accel_mps2) => {
+                    let cmd = RateCommand {
+                        rate_mps,
+                        accel_mps2,
+                        safe_hold: false,
+                    };
+                    let mut copies: [SpeedLoop; K] = core::array::from_fn(|_| drive.clone());
+                    let cost = m.per_call(&mut copies, |d| d.set_command(black_box(cmd), tick));
+                    r.command.add(cost, tick);
+                    let _ = drive.set_command(cmd, tick);
+                }
+                Action::Jam => drum.jammed = true,
+                Action::ClearTrip => {
+                    drive.clear_trip();
+                    drum.jammed = false;
+                }
+            }
+            let input = DriveInput {
+                tick,
+                encoder_count: (!t.count_missing)
+                    .then(|| drum.raw_count().wrapping_add(t.count_offset)),
+                tension_n: t.tension_n,
+            };
+            let mut copies: [SpeedLoop; K] = core::array::from_fn(|_| drive.clone());
+            let cost = m.per_call(&mut copies, |d| {
+                black_box(d.step(black_box(&input)));
+            });
+            let out = *drive.step(&input);
+            r.step.add(cost, tick);
+            let s = &mut r.states[state_index(out.brake)];
+            s.n += 1;
+            s.sum += u64::from(cost);
+            s.max = s.max.max(cost);
+            drum.advance(out.duty, out.brake.brake_released(), 20.0);
+        }
+    }
+
+    /// Measures one scenario and prints its figures.
+    #[inline(never)]
+    pub fn measure(m: &Meter, name: &str, ticks: u32, scenario: impl FnMut(u32) -> Tick) {
+        let mut r = Run {
+            step: Stats::new(),
+            states: [StateStats {
+                n: 0,
+                sum: 0,
+                max: 0,
+            }; 4],
+            command: Stats::new(),
+        };
+        run(m, &mut r, ticks, scenario);
+        let s = &r.step;
+        defmt::info!(
+            "{=str}: SpeedLoop::step instructions over {=u32} steps: median {=u32}, p99 {=u32}, worst {=u32} (tick {=u32}), mean {=u32}; budget {=u32}: {=str}",
+            name,
+            s.n,
+            s.quantile(500),
+            s.quantile(990),
+            s.max.0,
+            s.max.1,
+            s.mean(),
+            BUDGET_INSTRUCTIONS,
+            if s.max.0 <= BUDGET_INSTRUCTIONS { "met" } else { "NOT MET" }
+        );
+        for (i, st) in r.states.iter().enumerate() {
+            if st.n > 0 {
+                defmt::info!(
+                    "{=str}: brake {=str}: {=u32} steps, mean {=u32}, worst {=u32}",
+                    name,
+                    STATES[i],
+                    st.n,
+                    (st.sum / u64::from(st.n)) as u32,
+                    st.max
+                );
+            }
+        }
+        let c = &r.command;
+        if c.n > 0 {
+            defmt::info!(
+                "{=str}: SpeedLoop::set_command over {=u32} commands: median {=u32}, worst {=u32}",
+                name,
+                c.n,
+                c.quantile(500),
+                c.max.0
+            );
+        }
+    }
+
+    /// The cost of the telemetry length (an i64 → f32 conversion and a product).
+    pub fn paid_out(m: &Meter) {
+        let mut drive = SpeedLoop::new(DriveConfig::example()).ok();
+        if let Some(d) = drive.as_mut() {
+            d.step(&DriveInput {
+                tick: 0,
+                encoder_count: Some(0),
+                tension_n: Some(20.0),
+            });
+            d.step(&DriveInput {
+                tick: 1,
+                encoder_count: Some(1234),
+                tension_n: Some(20.0),
+            });
+        }
+        let Some(d) = drive else {
+            crate::exit::failure();
+        };
+        let mut copies: [SpeedLoop; K] = core::array::from_fn(|_| d.clone());
+        let cost = m.per_call(&mut copies, |d| d.paid_out_m());
+        defmt::info!("SpeedLoop::paid_out_m: {=u32} instructions", cost);
+    }
+}
+
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    use bench::{Action, Meter, Tick, INSTRUCTIONS_PER_COUNT, K};
+
+    let Some(core) = cortex_m::Peripherals::take() else {
+        defmt::error!("core peripherals already taken");
+        exit::failure();
+    };
+    let meter = Meter::start(core.SYST);
+    let delay = meter.instructions_of_delay(200_000);
+    defmt::info!(
+        "clock: {=u32} instructions per SysTick count (checked: a 400000-instruction delay loop reads {=u32}), K = {=usize} copies per measurement, loop overhead {=u32} instructions per {=usize} calls",
+        INSTRUCTIONS_PER_COUNT,
+        delay,
+        K,
+        meter.overhead(),
+        K
+    );
+    if delay.abs_diff(400_000) > 400 {
+        defmt::error!(
+            "the clock is not 1 instruction per ns: run QEMU with -icount shift=0 (see the example's docs)"
+        );
+        exit::failure();
+    }
+
+    let quiet = |action| Tick {
+        action,
+        count_offset: 0,
+        count_missing: false,
+        tension_n: Some(20.0),
+    };
+    // The law's ramp once a second: 0.5 m/s² to 5 m/s, hold, stop, brake.
+    bench::measure(&meter, "mission", 20_000, |tick| {
+        let action = match (tick % 1000, tick / 1000) {
+            (0, s) if s < 13 => {
+                let rate = (0.5 * (s + 1) as f32).min(5.0);
+                Action::Command(rate, if rate < 5.0 { 0.5 } else { 0.0 })
+            }
+            (0, 15) => Action::Command(0.0, -5.0),
+            _ => Action::None,
+        };
+        quiet(action)
+    });
+    // Faults, each for a while: see the crate docs.
+    bench::measure(&meter, "faults", 12_000, |tick| {
+        let mut t = quiet(match tick {
+            0 => Action::Command(0.5, 0.0),
+            1000 => Action::Command(10.0, 5.0),
+            4000 => Action::Command(2.0, -5.0),
+            6000 => Action::Command(f32::NAN, 0.0),
+            7000 => Action::Command(1.0, 1.0),
+            8000 => Action::Jam,
+            9500 => Action::ClearTrip,
+            _ => Action::None,
+        });
+        match tick {
+            5000 => t.count_offset = 20_000,
+            5100..=5109 => t.count_missing = true,
+            5200 => t.tension_n = Some(f32::NAN),
+            5201 => t.tension_n = None,
+            5202 => t.tension_n = Some(1e6),
+            // A counter that lost counts for good: jumps until the encoder trip.
+            11_000.. => t.count_offset = 20_000,
+            _ => {}
+        }
+        t
+    });
+    bench::paid_out(&meter);
+
+    defmt::info!("bench done");
+    exit::success()
+}

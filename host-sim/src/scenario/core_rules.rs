@@ -1,0 +1,155 @@
+//! The flight controller's own rules, named by scenario key. The scenario does not repeat them:
+//! it builds the f32 controller the run will fly (`Controller::<f32>::new`, which runs
+//! `Config::validate`) and maps the parameter path of the `ConfigError` it returns back to the
+//! scenario key it came from. Because the check runs in f32, a value that overflows (or
+//! underflows) the flight build's scalar type is caught here, before any work, and not as an
+//! `inf` later in the run.
+//!
+//! The controller stops at the first parameter it rejects, so at most one problem comes from
+//! here; the scenario's own rules (in the section files) all report at once.
+
+use tss_reel::controller::{ConfigError, Controller, Rule};
+use tss_reel::equilibrium::ECCENTRICITY_LIMIT;
+
+use super::rules::{num, Validator};
+use super::{nominal_value, Problem, Scenario};
+
+/// Records the first rule the flight controller's configuration breaks, if any.
+pub(super) fn check(sc: &Scenario, v: &mut Validator) {
+    if let Err(e) = Controller::<f32>::new(sc.controller_config::<f32>()) {
+        v.problems.push(problem(sc, &e));
+    }
+}
+
+/// `e` as a problem of the scenario key it came from, with the scenario's value (as written,
+/// in f64) and the rule in words.
+fn problem(sc: &Scenario, e: &ConfigError) -> Problem {
+    let field = scenario_key(sc, e);
+    let x = nominal_value(sc, &field).unwrap_or(e.value);
+    Problem {
+        message: message(sc, e, &field, x),
+        value: num(x),
+        field,
+        from_override: false,
+    }
+}
+
+/// The scenario key a controller parameter path comes from.
+fn scenario_key(sc: &Scenario, e: &ConfigError) -> String {
+    let key = match e.param {
+        "period_s" => "controller.period_s",
+        "gains.k1_per_s" => "controller.k1_per_s",
+        "gains.k2_per_s2" => "controller.k2_per_s2",
+        "keep_capture_m" => "controller.keep_capture_m",
+        "initial_rate_mps" => "initial.length_rate_mps",
+        "masses.tether_density_kg_per_m" => "tether.density_kg_per_m",
+        "stage1.schedule.low_angle_rad" => "stage1.deploy_angle_rad",
+        "stage1.schedule.high_length_m" => "stage1.keep_length_m",
+        "stage2.schedule.high_angle_rad" => "stage2.retrieve_angle_rad",
+        "stage2.schedule.low_length_m" => "stage2.keep_length_m",
+        // A whole schedule: an inverted band is named by its band start; a value that is not
+        // finite (in f32) by the first such field.
+        "stage1.schedule" | "stage2.schedule" => {
+            let stage = &e.param[..6];
+            let fields: [&str; 4] = if stage == "stage1" {
+                [
+                    "stage1.band_start_m",
+                    "stage1.deploy_angle_rad",
+                    "stage1.keep_length_m",
+                    "stage1.keep_slope_rad_per_m",
+                ]
+            } else {
+                [
+                    "stage2.keep_length_m",
+                    "stage2.keep_slope_rad_per_m",
+                    "stage2.band_start_m",
+                    "stage2.retrieve_angle_rad",
+                ]
+            };
+            let in_f32 = |k: &&str| nominal_value(sc, k).map(|x| x as f32);
+            match e.rule {
+                Rule::NotFinite => fields
+                    .iter()
+                    .find(|k| in_f32(k).is_some_and(|x| !x.is_finite()))
+                    .copied()
+                    .unwrap_or(fields[0]),
+                _ if stage == "stage1" => "stage1.band_start_m",
+                _ => "stage2.band_start_m",
+            }
+        }
+        // orbit.*, masses.*, stage1/2 rates, monitor.*, envelope.*: the same path.
+        same => same,
+    };
+    key.to_string()
+}
+
+/// The rule `e` states, in the scenario's words (the other keys it compares with, by name and
+/// value).
+fn message(sc: &Scenario, e: &ConfigError, key: &str, x: f64) -> String {
+    let env = &sc.envelope;
+    if x.is_finite() && !e.value.is_finite() {
+        return format!(
+            "overflows the controller's f32 (largest finite value {:e})",
+            f32::MAX
+        );
+    }
+    match e.rule {
+        Rule::NotFinite => "must be a finite number".to_string(),
+        Rule::Negative | Rule::NoEquilibrium if key == "orbit.eccentricity" => format!(
+            "must be in [0, {ECCENTRICITY_LIMIT}): beyond it no equilibrium exists over the \
+             whole orbit (Eq. 13)"
+        ),
+        Rule::NotPositive if key.ends_with("_ticks") => "must be at least 1".to_string(),
+        Rule::NotPositive if x > 0.0 => {
+            format!(
+                "must be above 0 (it is {} in the controller's f32)",
+                e.value
+            )
+        }
+        Rule::NotPositive => "must be above 0".to_string(),
+        Rule::Negative => "must not be negative".to_string(),
+        Rule::BandInverted => match key {
+            "envelope.max_length_m" => format!(
+                "must be above envelope.min_length_m = {}",
+                num(env.min_length_m)
+            ),
+            "monitor.max_orbit_rate_radps" => format!(
+                "must be above monitor.min_orbit_rate_radps = {}",
+                num(sc.monitor.min_orbit_rate_radps)
+            ),
+            "stage1.band_start_m" => format!(
+                "must be below stage1.keep_length_m = {}",
+                num(sc.stage1.keep_length_m)
+            ),
+            "stage2.band_start_m" => format!(
+                "must be above stage2.keep_length_m = {}",
+                num(sc.stage2.keep_length_m)
+            ),
+            _ => "must be above its lower bound".to_string(),
+        },
+        Rule::OutsideEnvelope if key == "initial.length_rate_mps" => format!(
+            "must be within ±envelope.max_rate_mps = {}",
+            num(env.max_rate_mps)
+        ),
+        Rule::OutsideEnvelope => format!(
+            "must be inside the envelope (envelope.min_length_m = {}, envelope.max_length_m = {})",
+            num(env.min_length_m),
+            num(env.max_length_m)
+        ),
+        Rule::WrongQuadrant if key.starts_with("stage1") => {
+            "must be within (−π/2, 0) (the deployment side, Eq. 33)".to_string()
+        }
+        Rule::WrongQuadrant => "must be within (0, π/2) (the retrieval side, Eq. 33)".to_string(),
+        Rule::TetherHeavierThanSatellite => format!(
+            "makes the tether at envelope.max_length_m = {} m weigh {} kg, not below \
+             masses.main_initial_kg = {}",
+            num(env.max_length_m),
+            num(sc.tether.density_kg_per_m * env.max_length_m),
+            num(sc.masses.main_initial_kg)
+        ),
+        Rule::NoEquilibrium => "leaves no equilibrium over the whole orbit (Eq. 13)".to_string(),
+        // A rule the controller learns after this mapping was written.
+        #[allow(unreachable_patterns)]
+        other => format!("breaks the controller's rule {other:?}"),
+    }
+}

@@ -1,0 +1,146 @@
+//! `[reel]`: the physical reel drive (`crate::reel::Reel` flies it; `convert` turns this
+//! section into its parameters).
+
+use serde::{Deserialize, Serialize};
+
+use super::rules::{num, Validator};
+
+/// Which reel model flies the tether.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ReelModelName {
+    /// The ideal reel, or the lagging, saturating drive when `lag_s` or a limit is set
+    /// (`crate::reel`).
+    #[default]
+    Drive,
+    /// The drum and motor with a speed loop, friction, torque limit and brake
+    /// (`crate::elastic::reel_drum`; elastic plant only).
+    Motor,
+}
+
+/// `[reel]`: the physical reel between the command and the tether. With `model = "drive"`
+/// (default) its actual rate v follows the command u as a first-order lag,
+/// dv/dt = (u − v)/lag_s, with its own rate and acceleration saturation (separate from the
+/// controller's `[envelope]`); with `model = "motor"` (elastic plant) a drum of radius r and
+/// inertia J follows u/r through a speed loop (the `drum_*`, `motor_*`, friction and brake keys;
+/// defaults: a 0.1 m, 0.05 kg·m² drum with a 2 N·m motor and a 5 rad/s speed loop).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReelSection {
+    /// `"drive"` (default) or `"motor"`.
+    #[serde(default)]
+    pub model: ReelModelName,
+    /// Hold the drum still: the tether neither pays out nor winds in, and the controller's
+    /// commands are logged and ignored (free-dynamics runs).
+    #[serde(default)]
+    pub locked: bool,
+    /// Time constant of the lag, s (0 = the rate follows the command at once).
+    #[serde(default)]
+    pub lag_s: f64,
+    /// Largest rate the drive can reach, m/s (inf = no limit).
+    #[serde(default = "infinity")]
+    pub max_rate_mps: f64,
+    /// Largest acceleration the drive can produce, m/s² (inf = no limit).
+    #[serde(default = "infinity")]
+    pub max_accel_mps2: f64,
+    /// Motor: drum radius r, m.
+    #[serde(default = "default_drum_radius_m")]
+    pub drum_radius_m: f64,
+    /// Motor: inertia of motor and drum referred to the drum, kg·m².
+    #[serde(default = "default_drum_inertia_kgm2")]
+    pub drum_inertia_kgm2: f64,
+    /// Motor: viscous friction, N·m·s/rad.
+    #[serde(default = "default_viscous_nms")]
+    pub viscous_nms: f64,
+    /// Motor: Coulomb (sliding) friction, N·m.
+    #[serde(default = "default_coulomb_nm")]
+    pub coulomb_nm: f64,
+    /// Motor: static (breakaway) friction, N·m (≥ coulomb_nm).
+    #[serde(default = "default_static_nm")]
+    pub static_nm: f64,
+    /// Motor: torque limit, N·m.
+    #[serde(default = "default_motor_max_torque_nm")]
+    pub motor_max_torque_nm: f64,
+    /// Motor: holding brake torque, applied while the command is zero, N·m.
+    #[serde(default = "default_brake_nm")]
+    pub brake_nm: f64,
+    /// Motor: speed-loop bandwidth (a double closed-loop pole at −ω_b), rad/s.
+    #[serde(default = "default_speed_bandwidth_radps")]
+    pub speed_bandwidth_radps: f64,
+}
+
+impl Default for ReelSection {
+    fn default() -> Self {
+        Self {
+            model: ReelModelName::Drive,
+            locked: false,
+            lag_s: 0.0,
+            max_rate_mps: f64::INFINITY,
+            max_accel_mps2: f64::INFINITY,
+            drum_radius_m: default_drum_radius_m(),
+            drum_inertia_kgm2: default_drum_inertia_kgm2(),
+            viscous_nms: default_viscous_nms(),
+            coulomb_nm: default_coulomb_nm(),
+            static_nm: default_static_nm(),
+            motor_max_torque_nm: default_motor_max_torque_nm(),
+            brake_nm: default_brake_nm(),
+            speed_bandwidth_radps: default_speed_bandwidth_radps(),
+        }
+    }
+}
+
+fn infinity() -> f64 {
+    f64::INFINITY
+}
+fn default_drum_radius_m() -> f64 {
+    0.1
+}
+fn default_drum_inertia_kgm2() -> f64 {
+    0.05
+}
+fn default_viscous_nms() -> f64 {
+    1e-3
+}
+fn default_coulomb_nm() -> f64 {
+    0.05
+}
+fn default_static_nm() -> f64 {
+    0.08
+}
+fn default_motor_max_torque_nm() -> f64 {
+    2.0
+}
+fn default_brake_nm() -> f64 {
+    1.0
+}
+fn default_speed_bandwidth_radps() -> f64 {
+    5.0
+}
+
+impl ReelSection {
+    /// A lag ≥ 0; saturations above 0 (inf = none); a drum of positive radius, inertia,
+    /// torque and bandwidth, frictions ≥ 0 with the static one at least the Coulomb one.
+    pub(super) fn check(&self, v: &mut Validator) {
+        v.non_negative("reel.lag_s", self.lag_s);
+        v.limit("reel.max_rate_mps", self.max_rate_mps);
+        v.limit("reel.max_accel_mps2", self.max_accel_mps2);
+        v.positive("reel.drum_radius_m", self.drum_radius_m);
+        v.positive("reel.drum_inertia_kgm2", self.drum_inertia_kgm2);
+        v.non_negative("reel.viscous_nms", self.viscous_nms);
+        let coulomb_ok = v.non_negative("reel.coulomb_nm", self.coulomb_nm);
+        if v.non_negative("reel.static_nm", self.static_nm) && coulomb_ok {
+            v.check(
+                self.static_nm >= self.coulomb_nm,
+                "reel.static_nm",
+                num(self.static_nm),
+                &format!(
+                    "must be at least reel.coulomb_nm = {}",
+                    num(self.coulomb_nm)
+                ),
+            );
+        }
+        v.positive("reel.motor_max_torque_nm", self.motor_max_torque_nm);
+        v.non_negative("reel.brake_nm", self.brake_nm);
+        v.positive("reel.speed_bandwidth_radps", self.speed_bandwidth_radps);
+    }
+}

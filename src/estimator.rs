@@ -1,0 +1,1127 @@
+//! The onboard libration estimator: an extended Kalman filter on the in-plane dynamics
+//! (Eq. 5b / 26 with β = 0) that estimates α and α̇ from a swing-angle sensor that measures α
+//! only (issue 18: no flight sensor measures α̇).
+//!
+//! # Model
+//!
+//! State x = (α, α̇, d): the in-plane angle, its rate, and d, an unmodelled angular
+//! acceleration (a disturbance torque per unit inertia). Between samples, in the orbit plane
+//! (β = 0), Eq. 5b reads
+//!
+//! ```text
+//!   α̈ = −(θ̇ + α̇) s(t) − (3μ/(2R³)) sin 2α − θ̈ + d,    s = (2 + μ3) l̇/l,    ḋ = white noise,
+//! ```
+//!
+//! driven by the reel's known rate and acceleration and the orbit's θ̇, θ̈ and μ/R³ ([`Drive`];
+//! n, 0 and n² on a circular orbit, where it is Eq. 26's −(n + α̇) s − 1.5 n² sin 2α); α̈ also
+//! receives white noise. d absorbs what the model leaves out: out-of-plane coupling (2β̇ tanβ
+//! terms), tether elasticity, errors of the reel's rate or length or of the orbit's terms, and
+//! an α-sensor bias (see *Observability*).
+//!
+//! # Discretisation (one control period h)
+//!
+//! The reel's rate is taken as a ramp over the period, l̇(t) = v + a t, and s is frozen at
+//! its value at mid-period, s = (2 + μ3)(v + a h/2)/(l + v h/2 + a h²/8) (the midpoint rule:
+//! second order in h). The Jacobian of the model at the current estimate is
+//!
+//! ```text
+//!       [  0    1   0 ]
+//!   A = [ −κ   −s   1 ],    κ = (3μ/R³) cos 2α̂ (the gravity-gradient stiffness),
+//!       [  0    0   0 ]
+//! ```
+//!
+//! and the estimate moves by the local-linearisation (exponential-Euler) step
+//! x⁺ = x + h φ₁(Ah) f(x), φ₁(Z) = (e^Z − I)/Z, exact for the linearised model and with a
+//! local error O(h³) for the nonlinear one; the covariance moves with Φ = e^{Ah} = I + h A φ₁(Ah).
+//! φ₁ is its Taylor series to (Ah)³/24. With u = s h and k = κ h², the series' first neglected
+//! term is of relative size (|u| + |k|)⁴/120: at most 5·10⁻⁴ inside the admitted
+//! |u| ≤ [`MAX_STRETCH_PER_PERIOD`], 1.1·10⁻⁵ at the paper's release (l = 1 m, l̇ = 0.1 m/s,
+//! u = 0.19), below 10⁻¹⁰ beyond l ≈ 20 m. The whole step's error against the simulator's plant
+//! integrated finely (`tests/estimator.rs::one_period_matches_the_plant`) is larger at the
+//! release, where s changes by 10 % within the period and the midpoint rule dominates:
+//! 7·10⁻⁴ of the period's α̇ change (1.3e-7 rad/s) and 1.5e-6 rad in α; 1.5·10⁻⁵ of it at
+//! l = 20 m; from 100 m on, below 1e-10 rad and 1e-13 rad/s. Against σ_α = 1e-4 rad and an
+//! α̇ uncertainty above 1e-7 rad/s at the release, the first minutes included, the period's
+//! discretisation is not a noticeable error source. Against the period, the error grows as h³
+//! (`::the_discretisation_error_against_the_period`: at l = 100 m, l̇ = 2 m/s, α̇ errs by
+//! 4.7e-10 rad/s at h = 1 s, 4.5e-8 at 5 s, 2.7e-7 at 10 s; at 9 km, 6.2e-12 rad/s at 10 s).
+//!
+//! # Observability (what α alone reveals)
+//!
+//! With H = (1 0 0): H, HA = (0 1 0) and HA² = (−κ −s 1) are independent whatever κ and s, so
+//! α, α̇ and d are always observable. An α-sensor **bias** b is a different matter: appended
+//! as a fourth state (H = (1 0 1 0)), the observability matrix has rank 3 with d (a constant
+//! bias and a constant torque d = κ b move the sensed equilibrium alike), and even without d
+//! its rank drops where κ = 0, i.e. at α = ±45°, the whole deployment plateau of Eq. 34: a
+//! bias is observable only through the gravity-gradient stiffness, over a libration period
+//! (≈ 57 min). This filter therefore estimates d, not b: a bias b makes α̂ read α + b (no
+//! filter on α alone can do better; the law then holds α_r − b), while α̇̂ stays unbiased
+//! because d̂ → κ b takes up the stiffness mismatch: with a 1e-3 rad bias, in stage 1 of the
+//! paper's mission from 1 h on, α̇̂'s error is 5.7e-8 rad/s RMS with a mean of −1.1e-8; the
+//! same filter without d (its drift and prior at their floors) errs by 3.6e-6 rad/s RMS
+//! (`tests/estimator.rs::a_constant_sensor_bias_leaves_the_rate_unbiased`).
+//!
+//! # Tuning ([`Config::paper`]) and the noise it assumes
+//!
+//! - α noise σ_α = 1e-4 rad per sample (issue 18's floor), not quantised (a quantum q adds
+//!   q²/12 to R).
+//! - d drifts as a random walk of density 1e-11 rad/s² per √s: it spans 4e-10 rad/s² in a
+//!   quarter orbit and 3e-9 rad/s² in a day. That covers, as slowly varying accelerations, a
+//!   1e-3 rad α bias seen through κ (≤ 3n² b = 3.4e-9 rad/s²) and a 1 mm/s reel-rate error
+//!   at 9 km (2n δl̇/l = 2.4e-10 rad/s²). It does not cover an eccentric orbit flown on the
+//!   circular model: at e = 1e-3 (θ̈ up to 2e n² = 2.2e-9 rad/s², at orbital frequency) α̇̂
+//!   errs by 1.7e-7 rad/s RMS in stage 1, 3.1e-8 with the true θ̈ and μ/R³ in the [`Drive`]
+//!   (`tests/estimator.rs::an_eccentric_orbit_needs_its_orbit_terms_in_the_drive`). The filter's bandwidth grows as q_d^(1/6), its α̇ noise
+//!   roughly as q_d^(1/4): a faster drift buys tracking with noise.
+//! - α̈ white noise of density 1e-9 rad/s² per √Hz: above the f32 rounding of one step.
+//! - At the start, α̇ within σ = 2e-3 rad/s (twice the orbit rate: any swing the law
+//!   survives) and d within 1e-6 rad/s².
+//!
+//! On the paper's mission with σ_α = 1e-4 rad (`tests/estimator.rs`), the f32 filter's α̇
+//! error is 3.6e-8 rad/s RMS, 1.6e-7 rad/s at worst, and its sample-to-sample jitter equals
+//! white noise of 2.8e-9 rad/s: far below the 1e-6 rad/s of white α̇ noise that slackens the
+//! tether (docs/hazards.md O-5) and below the 1e-7 rad/s that does not. Over a Monte Carlo of
+//! 50 missions whose truth carries exactly the assumed disturbances, the NEES averages 3.00
+//! (3 degrees of freedom) and the NIS 1.00.
+//!
+//! # Gating and faults
+//!
+//! Each sample's innovation ν = z − α̂⁻ has variance S = P_αα⁻ + R; its normalised square
+//! NIS = ν²/S is χ² with one degree of freedom when the filter is consistent. A sample with
+//! NIS above [`Config::gate_nis`] (default 16: 4σ, a false rejection once in 16 000
+//! samples) is **rejected**, reported as [`Measurement::Gated`], and the filter predicts
+//! only. After [`Config::max_rejections`] consecutive rejections the next sample is taken as a
+//! new start for α ([`Measurement::Reinitialised`]): a filter that gates everything out has
+//! lost the sensor's track, and must not stay locked on its own prediction.
+//!
+//! # Covariance
+//!
+//! The covariance is stored as its upper triangle, so it is symmetric by construction. The
+//! update is the Joseph form P⁺ = (I − KH) P⁻ (I − KH)ᵀ + K R Kᵀ, a sum of two positive
+//! semidefinite terms whatever rounding does to K (the short form (I − KH)P⁻ is not), written
+//! out for H = (1 0 0). Negative rounding residue on the diagonal is cut to zero (adding a
+//! non-negative diagonal keeps P positive semidefinite). After each prediction a variance
+//! above its cap ([`ALPHA_VARIANCE_CAP_RAD2`], the initial α̇ and d variances) is brought back
+//! to the cap, its covariances scaled down with it (a congruence plus a non-negative diagonal,
+//! which keeps P positive semidefinite), so a dropout of any length cannot overflow f32 and
+//! ends no less certain than a fresh start. Each prediction also grows the variances by [`ROUNDING_LOAD`] of themselves,
+//! the process noise of the f32 rounding: without it a dropout lasting hours takes P to rank
+//! one, where rounding makes it indefinite.
+//!
+//! # Cost
+//!
+//! Plain scalars on the structure, not nalgebra matrices: Φ's d row is e₃ᵀ and P is symmetric,
+//! so Φ P Φᵀ is 30 multiply-adds on the 6 stored entries, and the Joseph update for H = (1 0 0)
+//! is 27; one sin_cos (of 2α̂) and two divisions a step. On the Cortex-M4F
+//! (`examples/bench_estimator.rs`, flight profile, over the paper mission) a step takes 408
+//! instructions with a sample (median; 445 at worst, in the first ticks, where the α̇
+//! variance sits at its cap), 318 in a dropout and 348 with a gated sample; nalgebra's general
+//! 3×3 forms of the two covariance products alone take 815 (Φ P Φᵀ + Q) and 1 170 (Joseph)
+//! at opt-level "s".
+
+use crate::real::Real;
+
+/// The largest |s h| = |(2 + μ3) l̇/l| h the one-step discretisation admits (see the module
+/// docs: the Taylor series of φ₁ is then accurate to 5·10⁻⁴). The paper's release is 0.2.
+pub const MAX_STRETCH_PER_PERIOD: f64 = 0.5;
+
+/// ε, the relative growth of each variance per period that stands for the rounding of the
+/// covariance propagation (see `Sym3::rounding_loaded`): 2⁻²², four f32 roundings.
+pub const ROUNDING_LOAD: f64 = 1.0 / 4_194_304.0;
+
+/// The cap on α's variance, rad² (1 rad of standard deviation: beyond it α̂ says nothing).
+pub const ALPHA_VARIANCE_CAP_RAD2: f64 = 1.0;
+
+/// The largest |α̇̂| a prediction may reach, rad/s (a thousand times the orbit rate; beyond it
+/// the estimate has diverged: [`Prediction::Diverged`]).
+pub const MAX_ALPHA_RATE_RADPS: f64 = 1.0;
+
+/// The largest orbit rate θ̇ a drive may give, rad/s (a 10⁻² rad/s orbit would be inside the
+/// Earth); its square bounds |θ̈| and μ/R³, which keeps 3(μ/R³)h² small for the discretisation.
+pub const MAX_ORBIT_RATE_RADPS: f64 = 1e-2;
+
+/// The longest tether a drive may give, m (a thousand kilometres: any real tether).
+pub const MAX_LENGTH_M: f64 = 1e6;
+
+/// The largest |μ3| a drive may give (μ3 of a tether lighter than its satellite is ≪ 1).
+pub const MAX_MU3: f64 = 1.0;
+
+/// The estimator's parameters. Validated once by [`Estimator::new`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Config<T> {
+    /// Control period h, s.
+    pub period_s: T,
+    /// σ_α, the standard deviation of the swing sensor's α noise per sample, rad.
+    pub alpha_noise_rad: T,
+    /// The swing sensor's quantum, rad (0: not quantised); adds quantum²/12 to R.
+    pub alpha_quantum_rad: T,
+    /// √q_α̈: the density of the white noise on α̈, rad/s² per √Hz (rad·s^-3/2).
+    pub accel_noise_density: T,
+    /// √q_d: the density of the random walk of the disturbance d, rad/s² per √s
+    /// (rad·s^-5/2).
+    pub disturbance_drift_density: T,
+    /// σ of α̇ at the start (and the cap on its variance), rad/s.
+    pub initial_rate_std_radps: T,
+    /// σ of d at the start (and the cap on its variance), rad/s².
+    pub initial_disturbance_std_radps2: T,
+    /// The χ² (one degree of freedom) gate on the NIS: samples above it are rejected.
+    pub gate_nis: T,
+    /// Consecutive rejections after which the next sample restarts α.
+    pub max_rejections: u16,
+}
+
+impl<T: Real> Config<T> {
+    /// The tuning for the paper's mission with a swing sensor of σ_α = 1e-4 rad at 1 s (the
+    /// module docs say what each figure covers):
+    ///
+    /// - d's drift, 1e-11 rad/s² per √s. The disturbances d stands for change smoothly, by at
+    ///   most ~3e-9 rad/s² over a quarter orbit (≈ 1 500 s). The filter's bandwidth is
+    ///   (q_d/(σ_α² h))^(1/6) ≈ 5e-3 rad/s, a time constant of about 200 s, so it follows them;
+    ///   a larger drift widens it (as q_d^(1/6)) and raises α̇̂'s noise (as q_d^(1/4)).
+    /// - α̈ white noise 1e-9 rad/s² per √Hz, far below d's effect over a period and far above
+    ///   the f32 rounding of α̇̂ (an ulp of 7e-12 rad/s per period).
+    /// - At the start, α̇ within σ = 2e-3 rad/s (twice the orbit rate: any swing the law
+    ///   survives) and d within 1e-6 rad/s².
+    /// - The gate 16 (4σ); 10 consecutive rejections restart α.
+    pub fn paper() -> Self {
+        Self {
+            period_s: T::ONE,
+            alpha_noise_rad: T::from_f64(1e-4),
+            alpha_quantum_rad: T::ZERO,
+            accel_noise_density: T::from_f64(1e-9),
+            disturbance_drift_density: T::from_f64(1e-11),
+            initial_rate_std_radps: T::from_f64(2e-3),
+            initial_disturbance_std_radps2: T::from_f64(1e-6),
+            gate_nis: T::from_f64(16.0),
+            max_rejections: 10,
+        }
+    }
+
+    /// Checks every parameter against its admitted range (chosen so that the filter's
+    /// variances and products stay finite and its divisions defined in f32); the first
+    /// violation is returned.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        in_range("period_s", self.period_s, 0.05, 10.0)?;
+        in_range("alpha_noise_rad", self.alpha_noise_rad, 1e-6, 0.5)?;
+        in_range("alpha_quantum_rad", self.alpha_quantum_rad, 0.0, 0.5)?;
+        in_range("accel_noise_density", self.accel_noise_density, 0.0, 1e-2)?;
+        in_range(
+            "disturbance_drift_density",
+            self.disturbance_drift_density,
+            1e-14,
+            1e-4,
+        )?;
+        in_range(
+            "initial_rate_std_radps",
+            self.initial_rate_std_radps,
+            1e-8,
+            MAX_ALPHA_RATE_RADPS,
+        )?;
+        in_range(
+            "initial_disturbance_std_radps2",
+            self.initial_disturbance_std_radps2,
+            1e-12,
+            1e-2,
+        )?;
+        in_range("gate_nis", self.gate_nis, 1.0, 1e4)?;
+        if self.max_rejections == 0 {
+            return Err(ConfigError {
+                param: "max_rejections",
+                value: 0.0,
+                min: 1.0,
+                max: f64::from(u16::MAX),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// `value` in [min, max] (NaN is not), or the error naming `param`. The bounds are compared
+/// in `T` (so an f32 configuration may use the bounds themselves).
+fn in_range<T: Real>(param: &'static str, value: T, min: f64, max: f64) -> Result<(), ConfigError> {
+    if value >= T::from_f64(min) && value <= T::from_f64(max) {
+        Ok(())
+    } else {
+        Err(ConfigError {
+            param,
+            value: value.to_f64(),
+            min,
+            max,
+        })
+    }
+}
+
+/// A rejected estimator parameter: its name (the field of [`Config`]), its value and the
+/// range it must lie in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ConfigError {
+    /// The field, e.g. `alpha_noise_rad`.
+    pub param: &'static str,
+    /// The offending value (widened to f64; NaN if it was NaN).
+    pub value: f64,
+    /// The smallest admitted value.
+    pub min: f64,
+    /// The largest admitted value.
+    pub max: f64,
+}
+
+impl core::fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "invalid estimator parameter {} = {}: must be in [{}, {}]",
+            self.param, self.value, self.min, self.max
+        )
+    }
+}
+
+/// What drove the libration over the period that just ended: the reel and the orbit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Drive<T> {
+    /// l at the start of the period, m.
+    pub length_m: T,
+    /// l̇ at the start of the period, m/s (the rate command held over it, or the measured rate).
+    pub rate_mps: T,
+    /// l̈ over the period, m/s² (0 for a rate held over the period).
+    pub accel_mps2: T,
+    /// The orbit rate θ̇, rad/s (n on a circular orbit).
+    pub orbit_rate_radps: T,
+    /// The orbit's angular acceleration θ̈, rad/s² (0 on a circular orbit).
+    pub orbit_accel_radps2: T,
+    /// The gravity gradient μ/R³, 1/s² (n² on a circular orbit).
+    pub gravity_gradient_per_s2: T,
+    /// μ3 at this length (Eq. 5; 0 for a massless tether).
+    pub mu3: T,
+}
+
+/// The input of a [`Drive`] that was refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum DriveInput {
+    /// `length_m`: not in (0, [`MAX_LENGTH_M`]].
+    Length,
+    /// `rate_mps`: not finite.
+    Rate,
+    /// `accel_mps2`: not finite.
+    Accel,
+    /// `orbit_rate_radps`: not in (0, [`MAX_ORBIT_RATE_RADPS`]].
+    OrbitRate,
+    /// `orbit_accel_radps2`: |θ̈| above [`MAX_ORBIT_RATE_RADPS`]² or not finite.
+    OrbitAccel,
+    /// `gravity_gradient_per_s2`: not in (0, [`MAX_ORBIT_RATE_RADPS`]²].
+    GravityGradient,
+    /// `mu3`: |μ3| > [`MAX_MU3`] or not finite.
+    Mu3,
+    /// |(2 + μ3) l̇/l| h at mid-period above [`MAX_STRETCH_PER_PERIOD`] (or the length at
+    /// mid-period not positive): the reel changes l too fast for one step.
+    Stretch,
+}
+
+/// A refused drive: which input, and its value (the value of |s h| for `Stretch`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DriveError {
+    /// The input at fault.
+    pub input: DriveInput,
+    /// Its value (widened to f64).
+    pub value: f64,
+}
+
+/// The estimate and its uncertainty.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Estimate<T> {
+    /// α̂, rad.
+    pub alpha_rad: T,
+    /// α̇̂, rad/s.
+    pub alpha_rate_radps: T,
+    /// d̂, the unmodelled angular acceleration, rad/s².
+    pub disturbance_radps2: T,
+    /// Var(α̂), rad².
+    pub alpha_var_rad2: T,
+    /// Var(α̇̂), rad²/s².
+    pub alpha_rate_var_rad2ps2: T,
+    /// Var(d̂), rad²/s⁴.
+    pub disturbance_var_rad2ps4: T,
+    /// Cov(α̂, α̇̂), rad²/s.
+    pub alpha_rate_cov_rad2ps: T,
+    /// Cov(α̂, d̂), rad²/s².
+    pub alpha_disturbance_cov_rad2ps2: T,
+    /// Cov(α̇̂, d̂), rad²/s³.
+    pub rate_disturbance_cov_rad2ps3: T,
+}
+
+/// A sample's innovation against the prediction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Innovation<T> {
+    /// ν = z − α̂⁻, rad.
+    pub innovation_rad: T,
+    /// S = Var(α̂⁻) + R, rad².
+    pub variance_rad2: T,
+    /// NIS = ν²/S (χ², one degree of freedom, for a consistent filter).
+    pub nis: T,
+}
+
+/// What the prediction over the last period did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Prediction {
+    /// The estimate was carried over the period.
+    Predicted,
+    /// There was no estimate to carry (before the first sample, or after a loss).
+    NoEstimate,
+    /// The drive was refused: the estimate is dropped (it cannot be carried over a period
+    /// whose motion is unknown) and the next sample starts afresh.
+    InvalidDrive(DriveError),
+    /// The predicted estimate left the physical range (|α̇̂| > [`MAX_ALPHA_RATE_RADPS`] or not
+    /// finite, e.g. a long dropout through an unstable retrieval): dropped as above.
+    Diverged,
+}
+
+/// What became of this period's α sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Measurement<T> {
+    /// Used in the update.
+    Accepted(Innovation<T>),
+    /// Rejected by the χ² gate (NIS > `gate_nis`): an outlier, for the fault logic to count.
+    Gated(Innovation<T>),
+    /// No sample this period: prediction only.
+    Missing,
+    /// A sample that is not a finite angle in [−π, π]: ignored, as a missing one.
+    Invalid,
+    /// The first sample (or the first after a loss) started the estimate.
+    Initialised,
+    /// After `max_rejections` consecutive rejections, this sample restarted α (α̇̂ and d̂ are
+    /// kept, with their variances reset to the start's).
+    Reinitialised(Innovation<T>),
+}
+
+/// One period of the estimator, explained.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Output<T> {
+    /// The estimate after this period's sample, if there is one.
+    pub estimate: Option<Estimate<T>>,
+    /// What the prediction did.
+    pub prediction: Prediction,
+    /// What became of the sample.
+    pub measurement: Measurement<T>,
+}
+
+/// A symmetric 3×3 matrix over (α, α̇, d), by its upper triangle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Sym3<T> {
+    aa: T,
+    aw: T,
+    ad: T,
+    ww: T,
+    wd: T,
+    dd: T,
+}
+
+/// The filter's state while it has an estimate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Track<T> {
+    alpha: T,
+    rate: T,
+    disturbance: T,
+    p: Sym3<T>,
+    /// Consecutive gated samples.
+    rejections: u16,
+}
+
+/// The libration estimator (see the module docs).
+///
+/// ```
+/// use tss_reel::estimator::{Config, Drive, Estimator, Measurement};
+/// let mut est = Estimator::<f32>::new(Config::paper()).unwrap();
+/// let n = 1.06e-3; // a circular orbit: θ̇ = n, θ̈ = 0, μ/R³ = n²
+/// let drive = Drive { length_m: 9_000.0, rate_mps: 1.0, accel_mps2: 0.0,
+///                     orbit_rate_radps: n, orbit_accel_radps2: 0.0,
+///                     gravity_gradient_per_s2: n * n, mu3: 0.0 };
+/// let out = est.step(&drive, Some(-0.78));
+/// assert_eq!(out.measurement, Measurement::Initialised);
+/// let out = est.step(&drive, Some(-0.78));
+/// assert!(matches!(out.measurement, Measurement::Accepted(_)));
+/// let e = out.estimate.unwrap();
+/// assert!(e.alpha_rate_var_rad2ps2 < 4e-6);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Estimator<T> {
+    config: Config<T>,
+    /// R = σ_α² + quantum²/12, rad².
+    measurement_var: T,
+    /// Q: the process noise of one period.
+    process: Sym3<T>,
+    /// The variance caps of α, α̇, d.
+    caps: [T; 3],
+    track: Option<Track<T>>,
+}
+
+impl<T: Real> Estimator<T> {
+    /// A filter with no estimate yet, or the first invalid parameter.
+    pub fn new(config: Config<T>) -> Result<Self, ConfigError> {
+        config.validate()?;
+        let h = config.period_s;
+        let f = T::from_f64;
+        let qw = config.accel_noise_density.sq();
+        let qd = config.disturbance_drift_density.sq();
+        let (h2, h3) = (h * h, h * h * h);
+        let (h4, h5) = (h2 * h2, h2 * h3);
+        // Q = ∫₀ʰ e^{Aτ} G q Gᵀ e^{Aᵀτ} dτ for white noise on α̈ (q_α̈) and on ḋ (q_d), with A
+        // reduced to its integrator chain over one period (the damping s and stiffness κ change
+        // Q by O(s h), O(κ h²): far below the precision of a noise density).
+        let process = Sym3 {
+            aa: qw * h3 / f(3.0) + qd * h5 / f(20.0),
+            aw: qw * h2 / f(2.0) + qd * h4 / f(8.0),
+            ad: qd * h3 / f(6.0),
+            ww: qw * h + qd * h3 / f(3.0),
+            wd: qd * h2 / f(2.0),
+            dd: qd * h,
+        };
+        Ok(Self {
+            config,
+            measurement_var: config.alpha_noise_rad.sq() + config.alpha_quantum_rad.sq() / f(12.0),
+            process,
+            caps: [
+                f(ALPHA_VARIANCE_CAP_RAD2),
+                config.initial_rate_std_radps.sq(),
+                config.initial_disturbance_std_radps2.sq(),
+            ],
+            track: None,
+        })
+    }
+
+    /// The validated parameters.
+    pub fn config(&self) -> &Config<T> {
+        &self.config
+    }
+
+    /// R, the α measurement variance, rad².
+    pub fn measurement_var_rad2(&self) -> T {
+        self.measurement_var
+    }
+
+    /// The current estimate, if any.
+    pub fn estimate(&self) -> Option<Estimate<T>> {
+        self.track.as_ref().map(Track::estimate)
+    }
+
+    /// Starts (or restarts) the estimate at a known α and α̇ (e.g. at release, where the
+    /// deployer holds the sub-satellite), with the variances of a first sample (R) and of the
+    /// start (`initial_rate_std_radps`², `initial_disturbance_std_radps2`²). Refused (the
+    /// filter unchanged) unless both are finite, |α| ≤ π and |α̇| ≤ [`MAX_ALPHA_RATE_RADPS`].
+    pub fn initialise(&mut self, alpha_rad: T, alpha_rate_radps: T) -> Result<(), Measurement<T>> {
+        let pi = T::from_f64(core::f64::consts::PI);
+        let rate_ok = alpha_rate_radps.abs() <= T::from_f64(MAX_ALPHA_RATE_RADPS);
+        if !(alpha_rad.abs() <= pi && rate_ok) {
+            return Err(Measurement::Invalid);
+        }
+        self.track = Some(self.start(alpha_rad, alpha_rate_radps, T::ZERO));
+        Ok(())
+    }
+
+    /// One control period: carries the estimate over the period that just ended under
+    /// `drive`, then updates it with this period's α sample (`None`: a dropout).
+    pub fn step(&mut self, drive: &Drive<T>, alpha_rad: Option<T>) -> Output<T> {
+        let prediction = match self.track {
+            None => Prediction::NoEstimate,
+            Some(track) => match self.predict(&track, drive) {
+                Ok(next) => {
+                    self.track = Some(next);
+                    Prediction::Predicted
+                }
+                Err(p) => {
+                    self.track = None;
+                    p
+                }
+            },
+        };
+        let measurement = self.update(alpha_rad);
+        Output {
+            estimate: self.estimate(),
+            prediction,
+            measurement,
+        }
+    }
+
+    /// A fresh track at α with α̇ and d given, and the start's variances.
+    fn start(&self, alpha: T, rate: T, disturbance: T) -> Track<T> {
+        Track {
+            alpha,
+            rate,
+            disturbance,
+            p: Sym3 {
+                aa: self.measurement_var,
+                aw: T::ZERO,
+                ad: T::ZERO,
+                ww: self.caps[1],
+                wd: T::ZERO,
+                dd: self.caps[2],
+            },
+            rejections: 0,
+        }
+    }
+
+    /// The drive's s = (2 + μ3) l̇/l at mid-period, 1/s, or the input at fault.
+    ///
+    /// The rate and the acceleration need no test of their own: a NaN or an infinity in
+    /// either makes s NaN or infinite, and a finite but absurd one makes |s h| too large.
+    fn stretch(&self, drive: &Drive<T>) -> Result<T, DriveError> {
+        let f = T::from_f64;
+        let (l, v, a, n, mu3) = (
+            drive.length_m,
+            drive.rate_mps,
+            drive.accel_mps2,
+            drive.orbit_rate_radps,
+            drive.mu3,
+        );
+        let h = self.config.period_s;
+        let half_h = f(0.5) * h;
+        let rate_mid = v + a * half_h;
+        let length_mid = l + (v + f(0.5) * a * half_h) * half_h;
+        let s = (f(2.0) + mu3) * rate_mid / length_mid;
+        let u = s * h;
+        let orbit_max = f(MAX_ORBIT_RATE_RADPS);
+        let gradient = drive.gravity_gradient_per_s2;
+        let inputs_in_range = l > T::ZERO
+            && l <= f(MAX_LENGTH_M)
+            && n > T::ZERO
+            && n <= orbit_max
+            && drive.orbit_accel_radps2.abs() <= orbit_max * orbit_max
+            && gradient > T::ZERO
+            && gradient <= orbit_max * orbit_max
+            && mu3.abs() <= f(MAX_MU3);
+        if inputs_in_range && length_mid > T::ZERO && u.abs() <= f(MAX_STRETCH_PER_PERIOD) {
+            Ok(s)
+        } else {
+            Err(refusal(drive, u))
+        }
+    }
+
+    /// The estimate and covariance carried over one period (module docs, *Discretisation*).
+    fn predict(&self, t: &Track<T>, drive: &Drive<T>) -> Result<Track<T>, Prediction> {
+        let f = T::from_f64;
+        let s = self.stretch(drive).map_err(Prediction::InvalidDrive)?;
+        let h = self.config.period_s;
+        // 3μ/(2R³), and κ = (3μ/R³) cos 2α̂.
+        let gradient = f(1.5) * drive.gravity_gradient_per_s2;
+        let (sin2a, cos2a) = (f(2.0) * t.alpha).sin_cos();
+        let stiffness = f(2.0) * gradient * cos2a;
+        // Eq. 5b at the estimate: f(x) = (α̇, α̈, 0).
+        let spin = drive.orbit_rate_radps + t.rate;
+        let accel = -spin * s - gradient * sin2a - drive.orbit_accel_radps2 + t.disturbance;
+        // Ψ = φ₁(Ah) = I + Ah/2 + (Ah)²/6 + (Ah)³/24, its α and α̇ rows (its d row is e₃ᵀ,
+        // and Ψ_α̇d = Ψ_αα̇), with u = s h and k = κ h²; Ψ_α̇α enters as hΨ_α̇α (dimensionless).
+        let u = s * h;
+        let k = stiffness * h * h;
+        let (sixth, twenty_fourth) = (f(1.0 / 6.0), f(1.0 / 24.0));
+        let psi_aa = T::ONE - k * sixth + u * k * twenty_fourth;
+        let psi_aw = h * (f(0.5) - u * sixth + (u * u - k) * twenty_fourth);
+        let psi_ad = h * h * (sixth - u * twenty_fourth);
+        let h_psi_wa = -f(0.5) * k + u * k * sixth + k * (k - u * u) * twenty_fourth;
+        let psi_ww =
+            T::ONE - f(0.5) * u + (u * u - k) * sixth + u * (f(2.0) * k - u * u) * twenty_fourth;
+        let psi_wd = psi_aw;
+        // x⁺ = x + h Ψ f(x).
+        let alpha = t.alpha + h * (psi_aa * t.rate + psi_aw * accel);
+        let rate = t.rate + h_psi_wa * t.rate + h * psi_ww * accel;
+        if !(rate.abs() <= f(MAX_ALPHA_RATE_RADPS) && alpha.is_finite()) {
+            return Err(Prediction::Diverged);
+        }
+        // Φ = I + h A Ψ: its α row is e₁ᵀ + hΨ_α̇·, its α̇ row e₂ᵀ + h(−κΨ_α· − sΨ_α̇· + e₃ᵀ),
+        // its d row e₃ᵀ.
+        let phi = [
+            [T::ONE + h_psi_wa, h * psi_ww, h * psi_wd],
+            [
+                -(stiffness * h * psi_aa + s * h_psi_wa),
+                T::ONE - h * (stiffness * psi_aw + s * psi_ww),
+                h * (T::ONE - stiffness * psi_ad - s * psi_wd),
+            ],
+        ];
+        let p =
+            t.p.propagated(&phi)
+                .rounding_loaded()
+                .plus(&self.process)
+                .capped(&self.caps);
+        Ok(Track {
+            alpha,
+            rate,
+            disturbance: t.disturbance,
+            p,
+            rejections: t.rejections,
+        })
+    }
+
+    /// The update with this period's sample (module docs, *Gating*, *Covariance*).
+    fn update(&mut self, sample: Option<T>) -> Measurement<T> {
+        let Some(z) = sample else {
+            return Measurement::Missing;
+        };
+        if z.is_nan() || z.abs() > T::from_f64(core::f64::consts::PI) {
+            return Measurement::Invalid;
+        }
+        let Some(t) = self.track else {
+            self.track = Some(self.start(z, T::ZERO, T::ZERO));
+            return Measurement::Initialised;
+        };
+        let r = self.measurement_var;
+        let nu = z - t.alpha;
+        let var = t.p.aa + r;
+        let inv = T::ONE / var;
+        let innovation = Innovation {
+            innovation_rad: nu,
+            variance_rad2: var,
+            nis: nu * nu * inv,
+        };
+        if innovation.nis > self.config.gate_nis {
+            if t.rejections >= self.config.max_rejections {
+                self.track = Some(self.start(z, t.rate, t.disturbance));
+                return Measurement::Reinitialised(innovation);
+            }
+            self.track = Some(Track {
+                rejections: t.rejections + 1,
+                ..t
+            });
+            return Measurement::Gated(innovation);
+        }
+        // K = P Hᵀ / S, H = (1 0 0).
+        let gain = [t.p.aa * inv, t.p.aw * inv, t.p.ad * inv];
+        self.track = Some(Track {
+            alpha: t.alpha + gain[0] * nu,
+            rate: t.rate + gain[1] * nu,
+            disturbance: t.disturbance + gain[2] * nu,
+            p: t.p.joseph(&gain, r),
+            rejections: 0,
+        });
+        Measurement::Accepted(innovation)
+    }
+}
+
+/// Which input of a refused drive is at fault (in the order of [`DriveInput`]), `u` = s h.
+fn refusal<T: Real>(drive: &Drive<T>, u: T) -> DriveError {
+    let f = T::from_f64;
+    let (l, n, mu3) = (drive.length_m, drive.orbit_rate_radps, drive.mu3);
+    let (input, value) = if !(l > T::ZERO && l <= f(MAX_LENGTH_M)) {
+        (DriveInput::Length, l)
+    } else if !drive.rate_mps.is_finite() {
+        (DriveInput::Rate, drive.rate_mps)
+    } else if !drive.accel_mps2.is_finite() {
+        (DriveInput::Accel, drive.accel_mps2)
+    } else if !(n > T::ZERO && n <= f(MAX_ORBIT_RATE_RADPS)) {
+        (DriveInput::OrbitRate, n)
+    } else if drive.orbit_accel_radps2.is_nan()
+        || drive.orbit_accel_radps2.abs() > f(MAX_ORBIT_RATE_RADPS).sq()
+    {
+        (DriveInput::OrbitAccel, drive.orbit_accel_radps2)
+    } else if !(drive.gravity_gradient_per_s2 > T::ZERO
+        && drive.gravity_gradient_per_s2 <= f(MAX_ORBIT_RATE_RADPS).sq())
+    {
+        (DriveInput::GravityGradient, drive.gravity_gradient_per_s2)
+    } else if mu3.is_nan() || mu3.abs() > f(MAX_MU3) {
+        (DriveInput::Mu3, mu3)
+    } else {
+        (DriveInput::Stretch, u)
+    };
+    DriveError {
+        input,
+        value: value.to_f64(),
+    }
+}
+
+impl<T: Real> Track<T> {
+    fn estimate(&self) -> Estimate<T> {
+        Estimate {
+            alpha_rad: self.alpha,
+            alpha_rate_radps: self.rate,
+            disturbance_radps2: self.disturbance,
+            alpha_var_rad2: self.p.aa,
+            alpha_rate_var_rad2ps2: self.p.ww,
+            disturbance_var_rad2ps4: self.p.dd,
+            alpha_rate_cov_rad2ps: self.p.aw,
+            alpha_disturbance_cov_rad2ps2: self.p.ad,
+            rate_disturbance_cov_rad2ps3: self.p.wd,
+        }
+    }
+}
+
+impl<T: Real> Sym3<T> {
+    /// Φ P Φᵀ for Φ whose α and α̇ rows are `phi` and whose d row is e₃ᵀ.
+    fn propagated(&self, phi: &[[T; 3]; 2]) -> Self {
+        let p = self;
+        let [f0, f1] = phi;
+        // M = Φ P, its first two rows (its third is P's).
+        let m0 = [
+            f0[0] * p.aa + f0[1] * p.aw + f0[2] * p.ad,
+            f0[0] * p.aw + f0[1] * p.ww + f0[2] * p.wd,
+            f0[0] * p.ad + f0[1] * p.wd + f0[2] * p.dd,
+        ];
+        let m1 = [
+            f1[0] * p.aa + f1[1] * p.aw + f1[2] * p.ad,
+            f1[0] * p.aw + f1[1] * p.ww + f1[2] * p.wd,
+            f1[0] * p.ad + f1[1] * p.wd + f1[2] * p.dd,
+        ];
+        // (M Φᵀ)_ij = M_i · Φ_j; Φ's d row is e₃ᵀ, so (M Φᵀ)_i2 = M_i2.
+        let dot = |m: &[T; 3], f: &[T; 3]| m[0] * f[0] + m[1] * f[1] + m[2] * f[2];
+        Self {
+            aa: dot(&m0, f0),
+            aw: dot(&m0, f1),
+            ad: m0[2],
+            ww: dot(&m1, f1),
+            wd: m1[2],
+            dd: p.dd,
+        }
+    }
+
+    /// The rounding noise of the period: each variance grown by [`ROUNDING_LOAD`] of itself.
+    ///
+    /// P + ε diag(P) lifts the smallest eigenvalue of P's correlation matrix by about ε each
+    /// period. Without it, a long dropout (d's growing uncertainty drives α and α̇ alike, so P
+    /// tends to rank one: correlations of 0.9999 and beyond) meets the f32 rounding of each
+    /// period (6e-8) and P turns indefinite within a day
+    /// (`tests/estimator.rs::a_dropout_of_days_stays_bounded_in_f32`).
+    fn rounding_loaded(&self) -> Self {
+        let grow = T::ONE + T::from_f64(ROUNDING_LOAD);
+        Self {
+            aa: self.aa * grow,
+            ww: self.ww * grow,
+            dd: self.dd * grow,
+            ..*self
+        }
+    }
+
+    /// The sum of two symmetric matrices.
+    fn plus(&self, q: &Self) -> Self {
+        Self {
+            aa: self.aa + q.aa,
+            aw: self.aw + q.aw,
+            ad: self.ad + q.ad,
+            ww: self.ww + q.ww,
+            wd: self.wd + q.wd,
+            dd: self.dd + q.dd,
+        }
+    }
+
+    /// Each variance above its cap brought to the cap, its covariances scaled by r = cap/var
+    /// (no square root): the result is D P D with D = diag(r) (1 where not capped) plus the
+    /// non-negative diagonal that lifts each capped variance from r²·var back to the cap, so
+    /// it stays positive semidefinite, and the capped state's correlations shrink by √r.
+    fn capped(&self, caps: &[T; 3]) -> Self {
+        if self.aa <= caps[0] && self.ww <= caps[1] && self.dd <= caps[2] {
+            return *self;
+        }
+        let ratio = |var: T, cap: T| if var > cap { cap / var } else { T::ONE };
+        let r = [
+            ratio(self.aa, caps[0]),
+            ratio(self.ww, caps[1]),
+            ratio(self.dd, caps[2]),
+        ];
+        Self {
+            aa: self.aa.min(caps[0]),
+            aw: self.aw * r[0] * r[1],
+            ad: self.ad * r[0] * r[2],
+            ww: self.ww.min(caps[1]),
+            wd: self.wd * r[1] * r[2],
+            dd: self.dd.min(caps[2]),
+        }
+    }
+
+    /// The Joseph-form update (I − K e₁ᵀ) P (I − K e₁ᵀ)ᵀ + r K Kᵀ, by its upper triangle:
+    /// with B = (I − K e₁ᵀ) P, B_ij = P_ij − K_i P_0j and the result is B_ij − B_i0 K_j + r K_i K_j.
+    /// Negative rounding residue on the diagonal is cut to zero.
+    fn joseph(&self, k: &[T; 3], r: T) -> Self {
+        let p = self;
+        let b00 = p.aa - k[0] * p.aa;
+        let b10 = p.aw - k[1] * p.aa;
+        let b20 = p.ad - k[2] * p.aa;
+        let b01 = p.aw - k[0] * p.aw;
+        let b02 = p.ad - k[0] * p.ad;
+        let b11 = p.ww - k[1] * p.aw;
+        let b12 = p.wd - k[1] * p.ad;
+        let b22 = p.dd - k[2] * p.ad;
+        Self {
+            aa: (b00 - b00 * k[0] + r * k[0] * k[0]).max(T::ZERO),
+            aw: b01 - b00 * k[1] + r * k[0] * k[1],
+            ad: b02 - b00 * k[2] + r * k[0] * k[2],
+            ww: (b11 - b10 * k[1] + r * k[1] * k[1]).max(T::ZERO),
+            wd: b12 - b10 * k[2] + r * k[1] * k[2],
+            dd: (b22 - b20 * k[2] + r * k[2] * k[2]).max(T::ZERO),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const N: f64 = 1.060_237_230_236_363_5e-3;
+
+    fn drive(length_m: f64, rate_mps: f64) -> Drive<f64> {
+        Drive {
+            length_m,
+            rate_mps,
+            accel_mps2: 0.0,
+            orbit_rate_radps: N,
+            orbit_accel_radps2: 0.0,
+            gravity_gradient_per_s2: N * N,
+            mu3: 0.0,
+        }
+    }
+
+    #[test]
+    fn every_invalid_parameter_is_named() {
+        let ok = Config::<f64>::paper();
+        assert!(Estimator::new(ok).is_ok());
+        type Edit = fn(&mut Config<f64>, f64);
+        let cases: [(&str, Edit); 8] = [
+            ("period_s", |c, v| c.period_s = v),
+            ("alpha_noise_rad", |c, v| c.alpha_noise_rad = v),
+            ("alpha_quantum_rad", |c, v| c.alpha_quantum_rad = v),
+            ("accel_noise_density", |c, v| c.accel_noise_density = v),
+            ("disturbance_drift_density", |c, v| {
+                c.disturbance_drift_density = v
+            }),
+            ("initial_rate_std_radps", |c, v| {
+                c.initial_rate_std_radps = v
+            }),
+            ("initial_disturbance_std_radps2", |c, v| {
+                c.initial_disturbance_std_radps2 = v
+            }),
+            ("gate_nis", |c, v| c.gate_nis = v),
+        ];
+        for (name, edit) in cases {
+            for bad in [f64::NAN, f64::INFINITY, -1.0, 1e9] {
+                let mut c = ok;
+                edit(&mut c, bad);
+                let e = Estimator::new(c).unwrap_err();
+                assert_eq!(e.param, name, "{bad}");
+                assert!(e.value.is_nan() == bad.is_nan());
+            }
+        }
+        let c = Config {
+            max_rejections: 0,
+            ..ok
+        };
+        assert_eq!(Estimator::new(c).unwrap_err().param, "max_rejections");
+    }
+
+    #[test]
+    fn invalid_drive_inputs_are_typed_and_drop_the_estimate() {
+        let good = drive(9_000.0, 1.0);
+        let cases = [
+            (
+                Drive {
+                    length_m: 0.0,
+                    ..good
+                },
+                DriveInput::Length,
+            ),
+            (
+                Drive {
+                    rate_mps: f64::NAN,
+                    ..good
+                },
+                DriveInput::Rate,
+            ),
+            (
+                Drive {
+                    accel_mps2: f64::INFINITY,
+                    ..good
+                },
+                DriveInput::Accel,
+            ),
+            (
+                Drive {
+                    orbit_rate_radps: 0.0,
+                    ..good
+                },
+                DriveInput::OrbitRate,
+            ),
+            (
+                Drive {
+                    orbit_accel_radps2: f64::NAN,
+                    ..good
+                },
+                DriveInput::OrbitAccel,
+            ),
+            (
+                Drive {
+                    gravity_gradient_per_s2: -1e-6,
+                    ..good
+                },
+                DriveInput::GravityGradient,
+            ),
+            (Drive { mu3: -3.0, ..good }, DriveInput::Mu3),
+            (
+                Drive {
+                    length_m: 1.0,
+                    rate_mps: 1.0,
+                    ..good
+                },
+                DriveInput::Stretch,
+            ),
+            (
+                Drive {
+                    length_m: 1.0,
+                    rate_mps: -5.0,
+                    ..good
+                },
+                DriveInput::Stretch,
+            ),
+        ];
+        for (d, input) in cases {
+            let mut e = Estimator::new(Config::paper()).unwrap();
+            e.step(&good, Some(-0.7));
+            assert!(e.estimate().is_some());
+            let out = e.step(&d, None);
+            match out.prediction {
+                Prediction::InvalidDrive(err) => assert_eq!(err.input, input, "{d:?}"),
+                p => panic!("{d:?}: {p:?}"),
+            }
+            assert_eq!(out.estimate, None);
+            // The next sample starts afresh.
+            let out = e.step(&good, Some(-0.7));
+            assert_eq!(out.prediction, Prediction::NoEstimate);
+            assert_eq!(out.measurement, Measurement::Initialised);
+        }
+    }
+
+    #[test]
+    fn at_rest_on_the_vertical_it_stays_there() {
+        // α = α̇ = 0 with the reel still is an equilibrium of Eq. 5b: the estimate does not
+        // move and α̇'s variance settles.
+        let mut e = Estimator::new(Config::paper()).unwrap();
+        let d = drive(10_000.0, 0.0);
+        for _ in 0..2_000 {
+            let out = e.step(&d, Some(0.0));
+            assert!(!matches!(out.measurement, Measurement::Gated(_)));
+        }
+        let est = e.estimate().unwrap();
+        assert_eq!(est.alpha_rad, 0.0);
+        assert_eq!(est.alpha_rate_radps, 0.0);
+        assert!(est.alpha_rate_var_rad2ps2 < 1e-14, "{est:?}");
+    }
+
+    #[test]
+    fn transition_is_the_matrix_exponential_of_the_jacobian() {
+        // With P = v vᵀ and (almost) no process noise, the predicted covariance is (Φv)(Φv)ᵀ:
+        // compare Φv with a fine integration of ẋ = A x, A the Jacobian at the estimate with
+        // the drive's mid-period s (κ = 3n² cos 2α̂).
+        let cfg = Config {
+            accel_noise_density: 0.0,
+            disturbance_drift_density: 1e-14,
+            ..Config::paper()
+        };
+        let e = Estimator::new(cfg).unwrap();
+        let d = Drive {
+            length_m: 1_000.0,
+            rate_mps: 75.0,
+            ..drive(0.0, 0.0)
+        };
+        let s = e.stretch(&d).unwrap();
+        assert!((s - 2.0 * 75.0 / 1037.5).abs() < 1e-15);
+        let alpha = 0.3_f64;
+        let kappa = 3.0 * N * N * (2.0 * alpha).cos();
+        let v = [1e-3, 2e-4, 1e-6];
+        let t = Track {
+            alpha,
+            rate: 0.0,
+            disturbance: 0.0,
+            p: Sym3 {
+                aa: v[0] * v[0],
+                aw: v[0] * v[1],
+                ad: v[0] * v[2],
+                ww: v[1] * v[1],
+                wd: v[1] * v[2],
+                dd: v[2] * v[2],
+            },
+            rejections: 0,
+        };
+        let p = e.predict(&t, &d).unwrap().p;
+        let mut x = v;
+        let steps = 100_000;
+        let dt = 1.0 / f64::from(steps);
+        let a = |x: [f64; 3]| [x[1], -kappa * x[0] - s * x[1] + x[2], 0.0];
+        for _ in 0..steps {
+            let k1 = a(x);
+            let k2 = a([0, 1, 2].map(|i| x[i] + 0.5 * dt * k1[i]));
+            let k3 = a([0, 1, 2].map(|i| x[i] + 0.5 * dt * k2[i]));
+            let k4 = a([0, 1, 2].map(|i| x[i] + dt * k3[i]));
+            x = [0, 1, 2].map(|i| x[i] + dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]));
+        }
+        // The series' first neglected term, (s h)⁵/120 ≈ 5e-7 relative on each factor Φv,
+        // bounds the error (twice that on a product, and a margin).
+        let tol = 4.0 * s.powi(5) / 120.0;
+        let close = |got: f64, want: f64| (got - want).abs() <= tol * want.abs();
+        assert!(close(p.aa, x[0] * x[0]), "{} vs {}", p.aa, x[0] * x[0]);
+        assert!(close(p.aw, x[0] * x[1]), "{} vs {}", p.aw, x[0] * x[1]);
+        assert!(close(p.ww, x[1] * x[1]), "{} vs {}", p.ww, x[1] * x[1]);
+        assert!(close(p.wd, x[1] * x[2]), "{} vs {}", p.wd, x[1] * x[2]);
+    }
+
+    #[test]
+    fn joseph_update_keeps_the_covariance_symmetric_positive() {
+        let p = Sym3 {
+            aa: 1e-8,
+            aw: 9.9e-12,
+            ad: 1e-15,
+            ww: 1e-14,
+            wd: 9e-19,
+            dd: 1e-22,
+        };
+        let r = 1e-8_f64;
+        let inv = 1.0 / (p.aa + r);
+        let k = [p.aa * inv, p.aw * inv, p.ad * inv];
+        let j = p.joseph(&k, r);
+        // Against the short form P − K S Kᵀ.
+        let s = p.aa + r;
+        let short = [
+            p.aa - k[0] * k[0] * s,
+            p.aw - k[0] * k[1] * s,
+            p.ww - k[1] * k[1] * s,
+        ];
+        assert!((j.aa - short[0]).abs() < 1e-12 * p.aa);
+        assert!((j.aw - short[1]).abs() < 1e-9 * p.aw.abs());
+        assert!((j.ww - short[2]).abs() < 1e-9 * p.ww);
+        // Leading minors positive.
+        assert!(j.aa > 0.0 && j.aa * j.ww - j.aw * j.aw > 0.0);
+    }
+
+    #[test]
+    fn caps_bound_the_covariance_and_never_raise_a_correlation() {
+        let p = Sym3 {
+            aa: 4.0,
+            aw: 0.0199,
+            ad: 1e-6,
+            ww: 1e-4,
+            wd: 1e-9,
+            dd: 1e-10,
+        };
+        let caps = [1.0, 4e-6, 1e-12];
+        let c = p.capped(&caps);
+        assert_eq!((c.aa, c.ww, c.dd), (1.0, 4e-6, 1e-12));
+        let corr = |a: f64, b: f64, ab: f64| (ab / (a * b).sqrt()).abs();
+        assert!(corr(c.aa, c.ww, c.aw) <= corr(p.aa, p.ww, p.aw));
+        assert!(corr(c.aa, c.dd, c.ad) <= corr(p.aa, p.dd, p.ad));
+        assert!(corr(c.ww, c.dd, c.wd) <= corr(p.ww, p.dd, p.wd));
+        // Still positive definite: leading minors of the result.
+        assert!(c.aa * c.ww - c.aw * c.aw > 0.0);
+        assert_eq!(p.capped(&[10.0, 1.0, 1.0]), p);
+    }
+
+    #[test]
+    fn initialise_refuses_what_is_not_an_angle() {
+        let mut e = Estimator::new(Config::<f32>::paper()).unwrap();
+        assert_eq!(e.initialise(f32::NAN, 0.0), Err(Measurement::Invalid));
+        assert_eq!(e.initialise(0.1, f32::INFINITY), Err(Measurement::Invalid));
+        assert_eq!(e.estimate(), None);
+        e.initialise(-0.61, 0.0).unwrap();
+        let est = e.estimate().unwrap();
+        assert_eq!(est.alpha_rad, -0.61);
+        assert_eq!(est.alpha_var_rad2, e.measurement_var_rad2());
+        assert_eq!(est.alpha_rate_var_rad2ps2, 2e-3_f32 * 2e-3);
+    }
+}

@@ -1,0 +1,232 @@
+//! Drum odometry from integer encoder counts: the paid-out length and the drum speed.
+//!
+//! The hardware counter is `bits` wide and wraps. Each accepted reading adds the signed change
+//! since the previous one, taken modulo 2^bits (shifted to the top of an `i32` and back, which
+//! sign-extends it), to a 64-bit total count. Everything else is a function of integers:
+//!
+//! - paid-out length = total count × (2π r / counts per drum revolution): no float is ever
+//!   accumulated, so the length does not drift however long the reel runs; pay out and wind
+//!   back the same counts and the length is exactly 0 again;
+//! - drum speed = (total now − total W samples ago) × m per count / ((tick now − tick then) ×
+//!   tick): a window difference of integers, so the quantisation is one count over W ticks
+//!   (15.3 µm / 8 ms ≈ 1.9 mm/s for [`DriveConfig::example`]) and nothing is integrated.
+//!
+//! A reading that moved further than the drum can turn in the ticks since the last accepted
+//! one (at [`FaultLimits::max_encoder_rate_mps`]) is an encoder jump: it is rejected, the total
+//! keeps its last value, and the next reading is compared with the last accepted one. A
+//! counter that glitched for one reading is thus recovered; one that lost counts for good keeps
+//! failing the check until the drive trips.
+//!
+//! [`FaultLimits::max_encoder_rate_mps`]: super::FaultLimits::max_encoder_rate_mps
+
+use super::config::{DriveConfig, SPEED_WINDOW_CAPACITY};
+
+/// Length of the sample history (a power of two above the largest window).
+const HISTORY: usize = 16;
+const _: () = assert!(HISTORY.is_power_of_two() && HISTORY > SPEED_WINDOW_CAPACITY);
+
+/// One accepted encoder reading.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Sample {
+    tick: u32,
+    total_counts: i64,
+}
+
+/// Why a reading was not accepted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum CountFault {
+    /// The count changed faster than the drum can turn.
+    Jump,
+    /// No reading this tick.
+    Missing,
+}
+
+/// The drum's odometer: integer total count, paid-out length and windowed speed.
+#[derive(Clone, Debug)]
+pub struct Odometer {
+    /// 32 − counter width: a raw change shifted left by this and back sign-extends it.
+    shift: u32,
+    max_counts_per_tick: u32,
+    m_per_count: f32,
+    /// m/s per count per tick: m per count / tick.
+    mps_per_count_per_tick: f32,
+    window: usize,
+    /// The last accepted raw counter value; `None` before the first reading and after a
+    /// [`resync`](Self::resync): the next reading is then the reference, not a change.
+    last_raw: Option<u32>,
+    /// The accepted readings, newest at `newest`; the reference reading fills every slot, so
+    /// the window always has a start (no count of valid entries to keep).
+    history: [Sample; HISTORY],
+    newest: usize,
+}
+
+impl Odometer {
+    /// An odometer for a validated configuration, at total count 0.
+    pub fn new(cfg: &DriveConfig) -> Self {
+        let m_per_count = cfg.geometry.m_per_count();
+        Self {
+            shift: 32_u32.saturating_sub(cfg.geometry.encoder_bits),
+            max_counts_per_tick: cfg.max_counts_per_tick(),
+            m_per_count,
+            mps_per_count_per_tick: m_per_count * cfg.inner_rate_hz as f32,
+            window: cfg.speed_window_ticks as usize,
+            last_raw: None,
+            history: [Sample::default(); HISTORY],
+            newest: 0,
+        }
+    }
+
+    /// Takes the counter reading of `tick` (`None`: no reading). Ticks must increase (the
+    /// speed loop checks that before it calls this). The first reading sets the origin.
+    pub fn update(&mut self, tick: u32, raw: Option<u32>) -> Result<(), CountFault> {
+        let raw = raw.ok_or(CountFault::Missing)?;
+        let Some(last_raw) = self.last_raw else {
+            // The reference reading: the total stays (0 at the first), the speed restarts at 0.
+            self.last_raw = Some(raw);
+            self.history = [Sample {
+                tick,
+                total_counts: self.total_counts(),
+            }; HISTORY];
+            return Ok(());
+        };
+        let last = self.newest_sample();
+        // The change modulo 2^bits, sign-extended: exact for |change| < 2^(bits−1).
+        let change =
+            ((raw.wrapping_sub(last_raw).wrapping_shl(self.shift)) as i32).wrapping_shr(self.shift);
+        let gap_ticks = tick.wrapping_sub(last.tick);
+        let allowed = self.max_counts_per_tick.saturating_mul(gap_ticks);
+        if change.unsigned_abs() > allowed {
+            return Err(CountFault::Jump);
+        }
+        self.last_raw = Some(raw);
+        self.newest = self.newest.wrapping_add(1) & (HISTORY - 1);
+        self.history[self.newest & (HISTORY - 1)] = Sample {
+            tick,
+            total_counts: last.total_counts.wrapping_add(i64::from(change)),
+        };
+        Ok(())
+    }
+
+    /// Forgets the counter's reference: the next reading is taken as the new one, and the
+    /// total count continues from where it is. For a counter that was lost (an encoder trip):
+    /// after a long gap a change of the counter is ambiguous modulo 2^bits, so the travel
+    /// during the outage is not counted, and the paid-out length must be re-referenced by the
+    /// outer loop's length sensor.
+    pub fn resync(&mut self) {
+        self.last_raw = None;
+    }
+
+    /// Ticks since the last accepted reading at `tick` (`None` before the first).
+    pub fn ticks_since_accepted(&self, tick: u32) -> Option<u32> {
+        self.last_raw
+            .map(|_| tick.wrapping_sub(self.newest_sample().tick))
+    }
+
+    /// Counts since the first reading (pay-out positive).
+    pub fn total_counts(&self) -> i64 {
+        self.newest_sample().total_counts
+    }
+
+    /// Tether paid out since the first reading, m: total count × m per count (a function of
+    /// the integer count; its error is the two roundings of this product, never accumulated).
+    pub fn paid_out_m(&self) -> f32 {
+        self.total_counts() as f32 * self.m_per_count
+    }
+
+    /// Drum surface speed, m/s (pay-out positive): the count difference over the last
+    /// `speed_window_ticks` accepted readings divided by their time. 0 before the second
+    /// reading (the drum starts braked, at rest).
+    pub fn speed_mps(&self) -> f32 {
+        let new = self.newest_sample();
+        let old = self.history[self.newest.wrapping_sub(self.window) & (HISTORY - 1)];
+        let ticks = new.tick.wrapping_sub(old.tick);
+        if ticks == 0 {
+            return 0.0;
+        }
+        // The window's change is bounded by the jump check (≤ 2^31), so it fits an i32.
+        let counts = new.total_counts.wrapping_sub(old.total_counts) as i32;
+        counts as f32 * self.mps_per_count_per_tick / ticks as f32
+    }
+
+    fn newest_sample(&self) -> Sample {
+        self.history[self.newest & (HISTORY - 1)]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn odo(bits: u32) -> Odometer {
+        let mut cfg = DriveConfig::example();
+        cfg.geometry.encoder_bits = bits;
+        if bits > 16 {
+            cfg.faults.encoder_trip_ticks = 100;
+        }
+        cfg.validate().unwrap();
+        Odometer::new(&cfg)
+    }
+
+    #[test]
+    fn a_16_bit_counter_wraps_both_ways_without_losing_a_count() {
+        let mut o = odo(16);
+        let mut raw: u32 = 65_000;
+        o.update(0, Some(raw)).unwrap();
+        // 1000 counts a tick forward through the wrap, 200 ticks, then back.
+        for t in 1..=200 {
+            raw = (raw + 1000) & 0xFFFF;
+            o.update(t, Some(raw)).unwrap();
+        }
+        assert_eq!(o.total_counts(), 200_000);
+        for t in 201..=400 {
+            raw = raw.wrapping_sub(1000) & 0xFFFF;
+            o.update(t, Some(raw)).unwrap();
+        }
+        assert_eq!(o.total_counts(), 0);
+        assert_eq!(o.paid_out_m(), 0.0);
+    }
+
+    #[test]
+    fn a_32_bit_counter_wraps_too() {
+        let mut o = odo(32);
+        o.update(0, Some(u32::MAX - 10)).unwrap();
+        o.update(1, Some(20)).unwrap();
+        assert_eq!(o.total_counts(), 31);
+        o.update(2, Some(u32::MAX - 10)).unwrap();
+        assert_eq!(o.total_counts(), 0);
+    }
+
+    #[test]
+    fn speed_is_the_window_difference() {
+        let mut o = odo(16);
+        let cfg = DriveConfig::example();
+        let mut raw = 0_u32;
+        for t in 0..20 {
+            o.update(t, Some(raw & 0xFFFF)).unwrap();
+            raw += 650; // 650 counts/ms = 9.97 m/s
+        }
+        let expect = 650.0 * cfg.geometry.m_per_count() * 1000.0;
+        assert!((o.speed_mps() - expect).abs() < 1e-4 * expect);
+    }
+
+    #[test]
+    fn a_jump_is_rejected_and_the_next_good_reading_accepted() {
+        let mut o = odo(16);
+        o.update(0, Some(100)).unwrap();
+        o.update(1, Some(200)).unwrap();
+        assert_eq!(o.update(2, Some(30_000)), Err(CountFault::Jump));
+        assert_eq!(o.total_counts(), 100);
+        assert_eq!(o.ticks_since_accepted(3), Some(2));
+        o.update(3, Some(400)).unwrap();
+        assert_eq!(o.total_counts(), 300);
+    }
+
+    #[test]
+    fn bits_above_the_counter_width_are_ignored() {
+        let mut o = odo(16);
+        o.update(0, Some(0xABCD_0005)).unwrap();
+        o.update(1, Some(0x1234_0009)).unwrap();
+        assert_eq!(o.total_counts(), 4);
+    }
+}

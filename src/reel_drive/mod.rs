@@ -1,0 +1,829 @@
+//! The reel's inner speed loop: the drum follows the outer law's rate command (issue 19).
+//!
+//! The outer controller ([`crate::controller`]) commands a reel rate l̇_real and its
+//! acceleration (Eq. 30) once a law period (1 s). The reel-mechanism MCU turns that into motor
+//! duty at the inner rate (≥ 100 Hz, 1 kHz in [`DriveConfig::example`]), one
+//! [`SpeedLoop::step`] per inner tick:
+//!
+//! 1. **Odometry** ([`encoder`]): the drum's speed and paid-out length from the integer encoder
+//!    count (wrap handled, jumps rejected), never from accumulated floats.
+//! 2. **Reference**: from the reference at the moment a command arrives, a ramp toward the
+//!    commanded rate at the Eq. 30 acceleration the law computed
+//!    ([`Output::accel_cmd_mps2`](crate::controller::Output::accel_cmd_mps2)), at least fast
+//!    enough to arrive within one law period and at most [`DriveConfig::max_accel_mps2`]; it
+//!    stops at the command (never passes it), so the drum never runs ahead of the law.
+//! 3. **Brake** ([`Brake`]): engaged at rest and in safe hold; released (with its mechanical
+//!    delay) before any motion; engaged again after the commanded and measured speed have been
+//!    ~0 for [`BrakeConfig::engage_ticks`].
+//! 4. **PI + feed-forward**, on the drum's surface speed, giving drum torque. With pay-out
+//!    positive, the drum obeys J ω̇ = τ + T r − b ω − c sgn ω (T the tether tension at the
+//!    reel), so the torque that makes it follow v_ref with acceleration a_ref is
+//!
+//!    ```text
+//!    τ = kp e + ∫ki e dt            e = v_ref − v          (PI)
+//!      + J a_ref / r                                         (inertia, Eq. 30's acceleration)
+//!      − T r                                                 (measured tension)
+//!      + b v_ref / r + c sat(v_ref / v_band)                 (viscous + Coulomb friction)
+//!    ```
+//!
+//!    and the duty is τ / τ_max, saturated at ± [`DriveConfig::duty_limit`]. Anti-windup is
+//!    **conditional integration**: the integral does not grow while the output is saturated and
+//!    the error pushes it further into saturation; it is also bounded to ± τ_max.
+//! 5. **Faults** ([`DriveFault`]), reported in every [`DriveOutput`]; the ones that leave the
+//!    drum uncontrolled (no encoder, a stalled motor, a failed actuator) trip the drive: motor
+//!    off, brake on, until [`SpeedLoop::clear_trip`].
+//!
+//! Time is the integer inner tick (one tick = 1 / [`DriveConfig::inner_rate_hz`]), as the
+//! outer loop's is: every duration is a tick difference.
+//!
+//! ```
+//! use tss_reel::reel_drive::{Brake, DriveConfig, DriveInput, RateCommand, SpeedLoop};
+//!
+//! let mut drive = SpeedLoop::new(DriveConfig::example()).expect("the example is valid");
+//! // The law asks for 0.1 m/s (its first deployment command, Eq. 29).
+//! drive.set_command(RateCommand { rate_mps: 0.1, accel_mps2: 0.0, safe_hold: false }, 0);
+//! let input = |tick| DriveInput { tick, encoder_count: Some(0), tension_n: Some(20.0) };
+//! assert!(matches!(drive.step(&input(0)).brake, Brake::Releasing { .. }));
+//! // While the brake lifts, the motor takes over the tension's torque (−T r = −2 N m of 5).
+//! assert!((drive.output().duty - (-0.4)).abs() < 1e-6);
+//! for tick in 1..=50 {
+//!     drive.step(&input(tick));
+//! }
+//! assert!(matches!(drive.output().brake, Brake::Released { .. }));
+//! assert!(drive.output().faults.is_empty());
+//! ```
+
+pub mod config;
+pub mod encoder;
+pub mod hal;
+
+pub use config::{
+    BrakeConfig, DriveConfig, DriveConfigError, DriveRule, DrumModel, FaultLimits, Geometry,
+    SpeedGains,
+};
+pub use encoder::{CountFault, Odometer};
+
+use crate::controller::{Health, Output};
+
+/// The rate command of one law period, as the inner loop needs it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RateCommand {
+    /// Commanded reel rate l̇_real, m/s (pay-out positive).
+    pub rate_mps: f32,
+    /// Commanded reel acceleration (Eq. 30), m/s².
+    pub accel_mps2: f32,
+    /// The outer controller is in safe hold: the brake may engage but not release.
+    pub safe_hold: bool,
+}
+
+impl From<&Output<f32>> for RateCommand {
+    fn from(o: &Output<f32>) -> Self {
+        Self {
+            rate_mps: o.rate_cmd_mps,
+            accel_mps2: o.accel_cmd_mps2,
+            safe_hold: o.health == Health::SafeHold,
+        }
+    }
+}
+
+/// One inner tick's sensor readings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DriveInput {
+    /// Inner tick count of this sample.
+    pub tick: u32,
+    /// The raw hardware encoder counter (only its low `encoder_bits` are used); `None` if the
+    /// read failed.
+    pub encoder_count: Option<u32>,
+    /// Tether tension at the reel, N; `None` if the read failed.
+    pub tension_n: Option<f32>,
+}
+
+/// The brake (and motor enable) state machine.
+///
+/// ```text
+///            command moving, not safe hold, encoder read       release_ticks elapsed
+///   Engaged ────────────────────────────────────────▶ Releasing ───────────────────▶ Released
+///     ▲  ▲ ◀──── command at rest, or safe hold ────────────┘                           │
+///     │  └────────── commanded and measured speed ~0 for engage_ticks ─────────────────┘
+///     └──── clear_trip ──── Tripped(fault) ◀── encoder lost, stall, actuator (from any) ──
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Brake {
+    /// Brake on, motor off (at rest, at start, in safe hold once at rest).
+    Engaged,
+    /// Brake lifting; the motor holds the tension's torque so the drum does not lurch.
+    Releasing {
+        /// Ticks until the brake is free.
+        ticks_left: u32,
+    },
+    /// Brake free; the speed loop drives the drum.
+    Released {
+        /// Consecutive ticks the commanded and measured speed have been ~0.
+        rest_ticks: u32,
+    },
+    /// A fault left the drum uncontrolled: brake on, motor off, until cleared.
+    Tripped(DriveFault),
+}
+
+impl Brake {
+    /// Whether the brake is commanded free (its pin energised).
+    pub fn brake_released(self) -> bool {
+        matches!(self, Self::Releasing { .. } | Self::Released { .. })
+    }
+
+    /// Whether the motor driver is enabled.
+    pub fn motor_enabled(self) -> bool {
+        self.brake_released()
+    }
+}
+
+/// A fault of the reel drive.
+///
+/// How each maps onto the outer controller's fault logic ([`crate::controller::Health`]): see
+/// [`DriveFault::outer_reaction`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(u8)]
+pub enum DriveFault {
+    /// The tick did not advance (repeated or backwards): the step did nothing.
+    Tick,
+    /// The encoder count moved faster than the drum can turn; the reading was rejected.
+    EncoderJump,
+    /// No encoder reading this tick (or none for longer than the loop can bridge).
+    EncoderMissing,
+    /// Large duty, no motion, for `stall_ticks`.
+    MotorStall,
+    /// The duty has been saturated for `saturation_ticks`: the drum cannot follow.
+    DutySaturated,
+    /// Tension missing, not finite, or outside [min, max] (slack, break, overload).
+    TensionOutOfRange,
+    /// The rate command was not finite: the drum is brought to rest as in safe hold.
+    CommandInvalid,
+    /// A pin or the PWM refused a write (reported by the driver, [`hal::HalReelDrive`]).
+    Actuator,
+}
+
+/// What the outer controller should make of a drive fault.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum OuterReaction {
+    /// Telemetry only: the drive copes (the outer envelope and length monitor cover it).
+    Report,
+    /// The reel's length (from this encoder) or its motion cannot be trusted this period: the
+    /// caller steps the outer controller with
+    /// [`Controller::step_missing`](crate::controller::Controller::step_missing), so it coasts
+    /// (`Health::Degraded`, `Fault::Sensor(Sensor::Missing)`) and, if the fault persists past
+    /// `coast_ticks`, goes to `Health::SafeHold`, whose zero command keeps the brake engaged.
+    LengthSampleMissing,
+}
+
+impl DriveFault {
+    /// Every fault, in bit order.
+    pub const ALL: [Self; 8] = [
+        Self::Tick,
+        Self::EncoderJump,
+        Self::EncoderMissing,
+        Self::MotorStall,
+        Self::DutySaturated,
+        Self::TensionOutOfRange,
+        Self::CommandInvalid,
+        Self::Actuator,
+    ];
+
+    /// The mapping onto the outer fault logic:
+    ///
+    /// | fault | reaction | outer hazard |
+    /// |---|---|---|
+    /// | `EncoderJump`, `EncoderMissing` | [`OuterReaction::LengthSampleMissing`] | HZ-1 / HZ-6 |
+    /// | `MotorStall`, `Actuator` | [`OuterReaction::LengthSampleMissing`] (the drive tripped) | HZ-7 |
+    /// | `DutySaturated` | [`OuterReaction::Report`] | HZ-7 |
+    /// | `TensionOutOfRange` | [`OuterReaction::Report`] | HZ-10 |
+    /// | `Tick`, `CommandInvalid` | [`OuterReaction::Report`] (the caller's own error) | HZ-12 |
+    pub fn outer_reaction(self) -> OuterReaction {
+        match self {
+            Self::EncoderJump | Self::EncoderMissing | Self::MotorStall | Self::Actuator => {
+                OuterReaction::LengthSampleMissing
+            }
+            Self::Tick | Self::DutySaturated | Self::TensionOutOfRange | Self::CommandInvalid => {
+                OuterReaction::Report
+            }
+        }
+    }
+
+    fn bit(self) -> u16 {
+        1 << self as u16
+    }
+}
+
+/// The faults of one tick (a set).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DriveFaults(u16);
+
+impl DriveFaults {
+    /// No fault.
+    pub const NONE: Self = Self(0);
+
+    /// Whether `f` is in the set.
+    pub fn contains(self, f: DriveFault) -> bool {
+        self.0 & f.bit() != 0
+    }
+
+    /// Whether the set is empty.
+    pub fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    /// Adds `f`.
+    pub fn insert(&mut self, f: DriveFault) {
+        self.0 |= f.bit();
+    }
+
+    /// The faults in the set.
+    pub fn iter(self) -> impl Iterator<Item = DriveFault> {
+        DriveFault::ALL
+            .into_iter()
+            .filter(move |f| self.contains(*f))
+    }
+
+    /// The strongest reaction any fault of the set asks of the outer controller.
+    pub fn outer_reaction(self) -> OuterReaction {
+        if self
+            .iter()
+            .any(|f| f.outer_reaction() == OuterReaction::LengthSampleMissing)
+        {
+            OuterReaction::LengthSampleMissing
+        } else {
+            OuterReaction::Report
+        }
+    }
+}
+
+/// What one inner step decided, and why: the duty and the parts it was made of.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DriveOutput {
+    /// The inner tick this output belongs to.
+    pub tick: u32,
+    /// Reference drum speed v_ref, m/s.
+    pub ref_rate_mps: f32,
+    /// Reference acceleration a_ref (the ramp's slope; 0 once the command is reached), m/s².
+    pub ref_accel_mps2: f32,
+    /// Measured drum surface speed v, m/s.
+    pub speed_mps: f32,
+    /// v_ref − v, m/s.
+    pub error_mps: f32,
+    /// Proportional part, N m.
+    pub p_nm: f32,
+    /// Integral part, N m.
+    pub i_nm: f32,
+    /// Inertia feed-forward J a_ref / r, N m.
+    pub ff_inertia_nm: f32,
+    /// Tension feed-forward −T r, N m.
+    pub ff_tension_nm: f32,
+    /// Friction feed-forward b v_ref / r + c sat(v_ref / v_band), N m.
+    pub ff_friction_nm: f32,
+    /// The tension the feed-forward used (the reading, clamped into range, or the last good
+    /// one), N.
+    pub tension_n: f32,
+    /// The sum of the parts before saturation, N m.
+    pub torque_nm: f32,
+    /// Motor duty in [−duty_limit, duty_limit] (sign = direction, pay-out positive).
+    pub duty: f32,
+    /// The duty was saturated this tick.
+    pub saturated: bool,
+    /// The brake after this step.
+    pub brake: Brake,
+    /// The faults of this step.
+    pub faults: DriveFaults,
+}
+
+impl DriveOutput {
+    const IDLE: Self = Self {
+        tick: 0,
+        ref_rate_mps: 0.0,
+        ref_accel_mps2: 0.0,
+        speed_mps: 0.0,
+        error_mps: 0.0,
+        p_nm: 0.0,
+        i_nm: 0.0,
+        ff_inertia_nm: 0.0,
+        ff_tension_nm: 0.0,
+        ff_friction_nm: 0.0,
+        tension_n: 0.0,
+        torque_nm: 0.0,
+        duty: 0.0,
+        saturated: false,
+        brake: Brake::Engaged,
+        faults: DriveFaults::NONE,
+    };
+}
+
+/// The ramp the reference follows toward the commanded rate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Ramp {
+    /// Reference at `start_tick`, m/s.
+    start_mps: f32,
+    start_tick: u32,
+    /// The commanded rate it stops at, m/s.
+    target_mps: f32,
+    /// Signed slope toward the target (0 if already there), m/s².
+    slope_mps2: f32,
+    /// Ticks from `start_tick` until the target is reached (integer time: the reference is the
+    /// target from then on, and never passes it before).
+    ramp_ticks: u32,
+}
+
+/// Constants derived once from the configuration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Derived {
+    tick_s: f32,
+    outer_period_per_s: f32,
+    inertia_per_radius: f32,
+    viscous_per_radius: f32,
+    coulomb_per_band: f32,
+    per_max_torque: f32,
+}
+
+/// The inner speed loop with its brake and fault logic.
+#[derive(Clone, Debug)]
+pub struct SpeedLoop {
+    cfg: DriveConfig,
+    derived: Derived,
+    odometer: Odometer,
+    /// The last command, as received (after sanitising).
+    command: RateCommand,
+    /// The last command was not finite (until a finite one arrives).
+    command_invalid: bool,
+    ramp: Ramp,
+    integral_nm: f32,
+    /// The tension the feed-forward uses (the last good reading, clamped into range), N.
+    tension_n: f32,
+    last_tick: Option<u32>,
+    stall_ticks: u32,
+    saturated_ticks: u32,
+    brake: Brake,
+    out: DriveOutput,
+}
+
+impl SpeedLoop {
+    /// A speed loop at rest, brake engaged, after validating `cfg`.
+    pub fn new(cfg: DriveConfig) -> Result<Self, DriveConfigError> {
+        cfg.validate()?;
+        let r = cfg.geometry.drum_radius_m;
+        let derived = Derived {
+            tick_s: cfg.tick_s(),
+            outer_period_per_s: cfg.inner_rate_hz as f32 / cfg.outer_period_ticks as f32,
+            inertia_per_radius: cfg.drum.inertia_kgm2 / r,
+            viscous_per_radius: cfg.drum.viscous_nm_per_radps / r,
+            coulomb_per_band: cfg.drum.coulomb_nm / cfg.drum.coulomb_band_mps,
+            per_max_torque: 1.0 / cfg.max_torque_nm,
+        };
+        Ok(Self {
+            cfg,
+            derived,
+            odometer: Odometer::new(&cfg),
+            command: RateCommand {
+                rate_mps: 0.0,
+                accel_mps2: 0.0,
+                safe_hold: false,
+            },
+            command_invalid: false,
+            ramp: Ramp {
+                start_mps: 0.0,
+                start_tick: 0,
+                target_mps: 0.0,
+                slope_mps2: 0.0,
+                ramp_ticks: 0,
+            },
+            integral_nm: 0.0,
+            tension_n: 0.0,
+            last_tick: None,
+            stall_ticks: 0,
+            saturated_ticks: 0,
+            brake: Brake::Engaged,
+            out: DriveOutput::IDLE,
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &DriveConfig {
+        &self.cfg
+    }
+
+    /// The last step's output.
+    pub fn output(&self) -> &DriveOutput {
+        &self.out
+    }
+
+    /// The odometer (total count, paid-out length, speed).
+    pub fn odometer(&self) -> &Odometer {
+        &self.odometer
+    }
+
+    /// The brake's state.
+    pub fn brake(&self) -> Brake {
+        self.brake
+    }
+
+    /// Takes a new rate command at inner tick `tick` (normally once a law period). The
+    /// reference ramps from where it is now toward it (see the module docs). A non-finite rate
+    /// or acceleration is [`DriveFault::CommandInvalid`] (returned, and reported by every step
+    /// until a finite command arrives): the drum is then brought to rest as in safe hold.
+    pub fn set_command(&mut self, cmd: RateCommand, tick: u32) -> Result<(), DriveFault> {
+        let valid = cmd.rate_mps.is_finite() && cmd.accel_mps2.is_finite();
+        self.command_invalid = !valid;
+        let max = self.cfg.max_speed_mps;
+        self.command = if valid {
+            RateCommand {
+                rate_mps: cmd.rate_mps.max(-max).min(max),
+                ..cmd
+            }
+        } else {
+            RateCommand {
+                rate_mps: 0.0,
+                accel_mps2: 0.0,
+                safe_hold: true,
+            }
+        };
+        let (now_mps, _) = self.reference_at(tick);
+        self.anchor(now_mps, tick);
+        if valid {
+            Ok(())
+        } else {
+            Err(DriveFault::CommandInvalid)
+        }
+    }
+
+    /// Trips the drive for `fault` (motor off, brake on) — for faults found outside the step,
+    /// such as a refused actuator write. A drive already tripped keeps its first fault.
+    pub fn trip(&mut self, fault: DriveFault) {
+        if !matches!(self.brake, Brake::Tripped(_)) {
+            self.brake = Brake::Tripped(fault);
+            self.out.brake = self.brake;
+            self.out.duty = 0.0;
+            self.integral_nm = 0.0;
+        }
+    }
+
+    /// Clears a trip: the brake stays engaged and releases again only for a moving command
+    /// and a fresh encoder reading, which becomes the counter's new reference
+    /// ([`Odometer::resync`]: whatever the drum did while tripped is not counted). Returns the
+    /// fault that was cleared.
+    pub fn clear_trip(&mut self) -> Option<DriveFault> {
+        match self.brake {
+            Brake::Tripped(f) => {
+                self.brake = Brake::Engaged;
+                self.stall_ticks = 0;
+                self.saturated_ticks = 0;
+                self.odometer.resync();
+                Some(f)
+            }
+            _ => None,
+        }
+    }
+
+    /// One inner tick: odometry, reference, brake, PI + feed-forward, faults. The duty and
+    /// brake in the output are what the hardware is to be set to.
+    pub fn step(&mut self, input: &DriveInput) -> &DriveOutput {
+        let tick = input.tick;
+        let mut faults = DriveFaults::NONE;
+        if self.command_invalid {
+            faults.insert(DriveFault::CommandInvalid);
+        }
+        // Integer time: the tick must advance (wrapping, by less than half the range).
+        let gap_ticks = match self.last_tick {
+            None => 1,
+            Some(last) => {
+                let gap = tick.wrapping_sub(last);
+                if gap == 0 || gap > i32::MAX as u32 {
+                    faults.insert(DriveFault::Tick);
+                    self.out.faults = faults;
+                    return &self.out;
+                }
+                gap
+            }
+        };
+        self.last_tick = Some(tick);
+
+        // Odometry. A gap longer than the encoder check can bridge loses the count.
+        let trip_ticks = self.cfg.faults.encoder_trip_ticks;
+        let count = if gap_ticks > trip_ticks {
+            Err(CountFault::Missing)
+        } else {
+            self.odometer.update(tick, input.encoder_count)
+        };
+        match count {
+            Ok(()) => {}
+            Err(CountFault::Jump) => faults.insert(DriveFault::EncoderJump),
+            Err(CountFault::Missing) => faults.insert(DriveFault::EncoderMissing),
+        }
+        let speed_mps = self.odometer.speed_mps();
+        let encoder_lost = gap_ticks > trip_ticks
+            || self
+                .odometer
+                .ticks_since_accepted(tick)
+                .is_some_and(|t| t > trip_ticks);
+        if encoder_lost {
+            let fault = match count {
+                Err(CountFault::Jump) => DriveFault::EncoderJump,
+                _ => DriveFault::EncoderMissing,
+            };
+            self.trip(fault);
+        }
+
+        let tension_n = self.tension(input.tension_n, &mut faults);
+        let (mut ramp_mps, mut ramp_accel_mps2) = self.reference_at(tick);
+        let was_released = matches!(self.brake, Brake::Released { .. });
+        self.brake = self.next_brake(tick, gap_ticks, ramp_mps, speed_mps, count.is_ok());
+        if !was_released && matches!(self.brake, Brake::Released { .. }) {
+            // Just released: the ramp restarted from rest at this tick.
+            (ramp_mps, ramp_accel_mps2) = self.reference_at(tick);
+        }
+
+        let d = self.derived;
+        let max_torque_nm = self.cfg.max_torque_nm;
+        let limit = self.cfg.duty_limit;
+        let mut ref_mps = 0.0;
+        let mut ref_accel_mps2 = 0.0;
+        let mut p_nm = 0.0;
+        let mut ff_inertia_nm = 0.0;
+        let mut ff_tension_nm = 0.0;
+        let mut ff_friction_nm = 0.0;
+        match self.brake {
+            Brake::Released { .. } => {
+                ref_mps = ramp_mps;
+                ref_accel_mps2 = ramp_accel_mps2;
+                p_nm = self.cfg.gains.kp_nm_per_mps * (ref_mps - speed_mps);
+                ff_inertia_nm = d.inertia_per_radius * ref_accel_mps2;
+                ff_tension_nm = -tension_n * self.cfg.geometry.drum_radius_m;
+                let coulomb_nm = clamp_abs(ref_mps * d.coulomb_per_band, self.cfg.drum.coulomb_nm);
+                ff_friction_nm = d.viscous_per_radius * ref_mps + coulomb_nm;
+            }
+            // The brake lifts: the motor takes over the tension's torque, nothing else.
+            Brake::Releasing { .. } => {
+                ff_tension_nm = -tension_n * self.cfg.geometry.drum_radius_m;
+                self.integral_nm = 0.0;
+            }
+            // The motor is off.
+            Brake::Engaged | Brake::Tripped(_) => self.integral_nm = 0.0,
+        }
+        let error_mps = ref_mps - speed_mps;
+        let without_i_nm = p_nm + ff_inertia_nm + ff_tension_nm + ff_friction_nm;
+        if matches!(self.brake, Brake::Released { .. }) {
+            // Conditional integration: no growth that pushes a saturated output further out.
+            let dt_s = gap_ticks as f32 * d.tick_s;
+            let candidate = clamp_abs(
+                self.integral_nm + self.cfg.gains.ki_nm_per_m * error_mps * dt_s,
+                max_torque_nm,
+            );
+            let duty = (without_i_nm + candidate) * d.per_max_torque;
+            let winding_up = duty.abs() > limit && duty * error_mps > 0.0;
+            if !winding_up {
+                self.integral_nm = candidate;
+            }
+        }
+        let torque_nm = without_i_nm + self.integral_nm;
+        let raw_duty = torque_nm * d.per_max_torque;
+        let saturated = raw_duty.abs() > limit;
+        let mut duty = clamp_abs(raw_duty, limit);
+
+        // Saturation held too long (reported), stall (trips).
+        self.saturated_ticks = if saturated {
+            self.saturated_ticks.saturating_add(gap_ticks)
+        } else {
+            0
+        };
+        if self.saturated_ticks >= self.cfg.faults.saturation_ticks {
+            faults.insert(DriveFault::DutySaturated);
+        }
+        let f = &self.cfg.faults;
+        let stalled = matches!(self.brake, Brake::Released { .. })
+            && duty.abs() >= f.stall_duty
+            && speed_mps.abs() <= f.stall_speed_mps;
+        self.stall_ticks = if stalled {
+            self.stall_ticks.saturating_add(gap_ticks)
+        } else {
+            0
+        };
+        if self.stall_ticks >= f.stall_ticks {
+            self.trip(DriveFault::MotorStall);
+        }
+        if let Brake::Tripped(f) = self.brake {
+            faults.insert(f);
+            duty = 0.0;
+        }
+
+        self.out = DriveOutput {
+            tick,
+            ref_rate_mps: ref_mps,
+            ref_accel_mps2,
+            speed_mps,
+            error_mps,
+            p_nm,
+            i_nm: self.integral_nm,
+            ff_inertia_nm,
+            ff_tension_nm,
+            ff_friction_nm,
+            tension_n,
+            torque_nm,
+            duty,
+            saturated,
+            brake: self.brake,
+            faults,
+        };
+        &self.out
+    }
+
+    /// Tether paid out since the first encoder reading, m (a function of the integer count).
+    pub fn paid_out_m(&self) -> f32 {
+        self.odometer.paid_out_m()
+    }
+
+    /// The tension the feed-forward uses: a reading inside [min, max] as is; a finite one
+    /// outside, clamped into it; a missing or non-finite one, the last good value. Anything
+    /// but the first is [`DriveFault::TensionOutOfRange`].
+    fn tension(&mut self, reading: Option<f32>, faults: &mut DriveFaults) -> f32 {
+        let (lo, hi) = (self.cfg.faults.min_tension_n, self.cfg.faults.max_tension_n);
+        match reading {
+            Some(t) if (lo..=hi).contains(&t) => self.tension_n = t,
+            Some(t) if t.is_finite() => {
+                self.tension_n = t.max(lo).min(hi);
+                faults.insert(DriveFault::TensionOutOfRange);
+            }
+            _ => faults.insert(DriveFault::TensionOutOfRange),
+        }
+        self.tension_n
+    }
+
+    /// The brake's next state (see [`Brake`]).
+    /// Entering `Released` restarts the ramp from rest at `tick` (the drum was held until now).
+    fn next_brake(
+        &mut self,
+        tick: u32,
+        gap_ticks: u32,
+        ref_mps: f32,
+        speed_mps: f32,
+        counted: bool,
+    ) -> Brake {
+        let rest = self.cfg.brake.rest_speed_mps;
+        let hold = self.command.safe_hold;
+        let target_moving = self.command.rate_mps.abs() > rest;
+        match self.brake {
+            Brake::Tripped(f) => Brake::Tripped(f),
+            Brake::Engaged => {
+                if target_moving && !hold && counted {
+                    Brake::Releasing {
+                        ticks_left: self.cfg.brake.release_ticks,
+                    }
+                } else {
+                    Brake::Engaged
+                }
+            }
+            Brake::Releasing { ticks_left } => {
+                if !target_moving || hold {
+                    Brake::Engaged
+                } else if ticks_left <= gap_ticks {
+                    self.anchor(0.0, tick);
+                    Brake::Released { rest_ticks: 0 }
+                } else {
+                    Brake::Releasing {
+                        ticks_left: ticks_left - gap_ticks,
+                    }
+                }
+            }
+            Brake::Released { rest_ticks } => {
+                let at_rest = !target_moving && ref_mps.abs() <= rest && speed_mps.abs() <= rest;
+                if !at_rest {
+                    Brake::Released { rest_ticks: 0 }
+                } else {
+                    let rest_ticks = rest_ticks.saturating_add(gap_ticks);
+                    if rest_ticks >= self.cfg.brake.engage_ticks {
+                        Brake::Engaged
+                    } else {
+                        Brake::Released { rest_ticks }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Restarts the ramp from `start_mps` at `tick` toward the command: its slope is the
+    /// command's (Eq. 30) acceleration if that points toward the command, at least what reaches
+    /// the command within one law period, at most `max_accel_mps2`.
+    fn anchor(&mut self, start_mps: f32, tick: u32) {
+        let target = self.command.rate_mps;
+        let dv = target - start_mps;
+        let law = if self.command.accel_mps2 * dv > 0.0 {
+            self.command.accel_mps2.abs()
+        } else {
+            0.0
+        };
+        let per_period = dv.abs() * self.derived.outer_period_per_s;
+        let fastest = if law > per_period { law } else { per_period };
+        let magnitude = clamp_abs(fastest, self.cfg.max_accel_mps2);
+        // Whole ticks to the target, rounded up (`as` saturates; 0 when already there).
+        let ticks = dv.abs() / magnitude * self.cfg.inner_rate_hz as f32;
+        let whole = ticks as u32;
+        self.ramp = Ramp {
+            start_mps,
+            start_tick: tick,
+            target_mps: target,
+            slope_mps2: magnitude.copysign(dv),
+            ramp_ticks: if (whole as f32) < ticks {
+                whole.saturating_add(1)
+            } else {
+                whole
+            },
+        };
+    }
+
+    /// The reference speed and acceleration at `tick`: the ramp, stopped at its target. (Only
+    /// used while the brake is free; the ramp restarts from rest when it is released.)
+    fn reference_at(&self, tick: u32) -> (f32, f32) {
+        let r = &self.ramp;
+        let age_ticks = tick.wrapping_sub(r.start_tick);
+        if age_ticks >= r.ramp_ticks {
+            (r.target_mps, 0.0)
+        } else {
+            let age_s = age_ticks as f32 * self.derived.tick_s;
+            (r.start_mps + r.slope_mps2 * age_s, r.slope_mps2)
+        }
+    }
+}
+
+/// `x` limited to [−limit, limit] (limit ≥ 0), by comparisons: `f32::clamp` panics on bad
+/// bounds, and `f32::min`/`max` are library calls (`fminf`/`fmaxf`) on the Cortex-M4F — with
+/// them the step took 420 instructions (median, `examples/bench_speed_loop.rs`), 328 with
+/// this and the reference evaluated once. A NaN `x` gives 0 (no torque).
+fn clamp_abs(x: f32, limit: f32) -> f32 {
+    if x > limit {
+        limit
+    } else if x < -limit {
+        -limit
+    } else if x.is_nan() {
+        0.0
+    } else {
+        x
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clamp_abs_saturates_and_zeroes_nan() {
+        assert_eq!(clamp_abs(2.0, 1.0), 1.0);
+        assert_eq!(clamp_abs(-2.0, 1.0), -1.0);
+        assert_eq!(clamp_abs(0.5, 1.0), 0.5);
+        assert_eq!(clamp_abs(f32::NAN, 1.0), 0.0);
+        assert_eq!(clamp_abs(f32::NEG_INFINITY, 1.0), -1.0);
+    }
+
+    #[test]
+    fn the_ramp_meets_the_command_within_a_period_and_never_passes_it() {
+        let mut s = SpeedLoop::new(DriveConfig::example()).unwrap();
+        // A limited command: 1 m/s reached at 1 m/s² (Eq. 30 value = the ramp's slope).
+        s.set_command(
+            RateCommand {
+                rate_mps: 1.0,
+                accel_mps2: 1.0,
+                safe_hold: false,
+            },
+            0,
+        )
+        .unwrap();
+        assert_eq!(s.reference_at(500), (0.5, 1.0));
+        assert_eq!(s.reference_at(1000), (1.0, 0.0));
+        assert_eq!(s.reference_at(5000), (1.0, 0.0));
+        // An acceleration pointing away from the command does not move the reference away.
+        s.set_command(
+            RateCommand {
+                rate_mps: 0.5,
+                accel_mps2: 2.0,
+                safe_hold: false,
+            },
+            1000,
+        )
+        .unwrap();
+        let (v, a) = s.reference_at(1500);
+        assert!((v - 0.75).abs() < 1e-6 && a == -0.5, "{v} {a}");
+    }
+
+    #[test]
+    fn the_faults_map_onto_the_outer_logic() {
+        let mut set = DriveFaults::NONE;
+        set.insert(DriveFault::TensionOutOfRange);
+        assert_eq!(set.outer_reaction(), OuterReaction::Report);
+        set.insert(DriveFault::EncoderJump);
+        assert_eq!(set.outer_reaction(), OuterReaction::LengthSampleMissing);
+        assert_eq!(
+            set.iter().collect::<heapless::Vec<_, 8>>().as_slice(),
+            &[DriveFault::EncoderJump, DriveFault::TensionOutOfRange]
+        );
+    }
+}
