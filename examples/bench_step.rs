@@ -80,8 +80,9 @@ mod bench {
     /// SysTick's reload value: the full 24-bit range (period 2²⁴ counts, 671 ms of virtual time).
     const RELOAD: u32 = 0x00FF_FFFF;
 
-    /// The 500-instruction budget of one step (issue 7), checked against the worst case.
-    pub const BUDGET_INSTRUCTIONS: u32 = 500;
+    /// The instruction budget of one step, checked against the worst case: 500 (issue 7),
+    /// then 550 for a readable controller (issue 15).
+    pub const BUDGET_INSTRUCTIONS: u32 = 550;
 
     /// The free-running SysTick (no interrupt), counting processor clocks.
     pub struct Meter {
