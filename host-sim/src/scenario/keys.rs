@@ -56,7 +56,7 @@ pub struct KeyInfo {
     pub schema_key: String,
     /// Its type.
     pub kind: LeafKind,
-    /// Its unit, read from its name (`_m`, `_mps`, …); empty when it has none.
+    /// Its unit, read from its name (`_m`, `_mps`, …) by [`unit_of`]; empty when it has none.
     pub unit: &'static str,
     /// Its default.
     pub default: KeyDefault,
