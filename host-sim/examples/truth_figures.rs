@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 use tss_sim::history::{History, PhaseLabel};
+use tss_sim::plots::{Figure, TetherShapes, SHAPE_FIGURE_SIZE_PX};
 use tss_sim::scenario::Scenario;
 use tss_sim::table1::PAPER_TABLE1;
 
@@ -291,29 +292,20 @@ fn main() -> anyhow::Result<()> {
         ],
         (1200, 800),
     )?;
-    // Shapes: along-track (e_θ) against radial (e_r), relative to the main satellite.
-    let colors = [GREY, BLUE, ORANGE, GREEN, RED, BLACK];
+    // Shapes: along-track (e_θ) against radial (e_r), relative to the main satellite, drawn
+    // as `tss-sim run` draws them (`plots::TetherShapes`), at six chosen instants.
     let picks = [7_200.0, 14_400.0, 28_800.0, 29_700.0, 30_600.0, 36_000.0];
-    let shapes: Vec<Curve> = picks
-        .iter()
-        .zip(colors)
-        .filter_map(|(t, c)| {
-            let (ts, nodes) = elastic.shapes.iter().find(|s| s.0 >= *t)?;
-            let pts = nodes.iter().map(|n| (n[1] / 1e3, n[0] / 1e3)).collect();
-            Some(curve(&format!("t = {:.2} h", ts / 3600.0), c, pts))
-        })
-        .collect();
-    draw(
-        &dir.join("truth_shapes.png"),
-        &[Panel {
-            caption: "Tether shape in the orbit frame (main satellite at 0; beads as vertices)"
-                .into(),
-            x_desc: "along-track e_θ (km)".into(),
-            y_desc: "radial e_r (km)".into(),
-            curves: shapes,
-        }],
-        (1000, 800),
-    )?;
+    let shapes_png = dir.join("truth_shapes.png");
+    let shapes = TetherShapes {
+        caption: "Tether shape in the orbit frame (main satellite at 0; beads as vertices)".into(),
+        shapes: picks
+            .iter()
+            .filter_map(|t| elastic.shapes.iter().find(|s| s.0 >= *t).cloned())
+            .collect(),
+    };
+    let root = BitMapBackend::new(&shapes_png, SHAPE_FIGURE_SIZE_PX).into_drawing_area();
+    shapes.draw(&root)?;
+    root.present()?;
     println!("figures written to {}", dir.display());
     Ok(())
 }

@@ -3,6 +3,9 @@
 //! - Fig. 4: tether length l (km) and tension T_t (N) against t (h), two panels.
 //! - Fig. 5: (a) the reference angle α_r and (b) the in-plane angle α (deg) against t (h).
 //! - Fig. 6: the same angles against l (km).
+//! - On the elastic plant, the tether's shape ([`TetherShapes`], `tether_shape`): one curve per
+//!   shape the run recorded (every `plant.shape_interval_s` and at the end), in the plane of the
+//!   orbit relative to the main satellite: along-track e_θ against radial e_r (km), equal scales.
 //!
 //! Text is rendered with plotters' `ttf` feature, which finds a sans-serif system font through
 //! fontconfig (DejaVu Sans on the project's Debian machines, package `fonts-dejavu-core`).
@@ -38,6 +41,14 @@ pub const FIGURE_STEMS: [&str; 3] = [
     "fig5_angles_time",
     "fig6_angles_length",
 ];
+
+/// File stem of the tether's shape figure (elastic plant only).
+pub const SHAPE_STEM: &str = "tether_shape";
+/// Pixel size of the shape figure (square: its two axes share one scale).
+pub const SHAPE_FIGURE_SIZE_PX: (u32, u32) = (1000, 1000);
+/// Legend entries of the shape figure at most (the other curves are drawn unlabelled; their
+/// colour runs from blue, early, to red, late).
+pub const MAX_SHAPE_LABELS: usize = 8;
 
 const LENGTH_COLOR: RGBColor = RGBColor(0x1f, 0x77, 0xb4);
 const TENSION_COLOR: RGBColor = RGBColor(0xd6, 0x27, 0x28);
@@ -121,9 +132,14 @@ pub fn write_png_and_svg(
     Ok(written)
 }
 
-/// The file names of the run's figures.
+/// The file names of the run's figures (the shape figure's too: a rigid run removes an
+/// earlier elastic run's).
 pub fn figure_names() -> Vec<String> {
-    FIGURE_STEMS.iter().flat_map(|s| png_and_svg(s)).collect()
+    FIGURE_STEMS
+        .iter()
+        .chain([&SHAPE_STEM])
+        .flat_map(|s| png_and_svg(s))
+        .collect()
 }
 
 /// A figure of panels stacked vertically.
@@ -152,7 +168,120 @@ pub fn write_figures(
             &Panels(panels),
         )?);
     }
+    if !history.shapes.is_empty() {
+        let shapes = TetherShapes {
+            caption: format!(
+                "Tether shape in the orbit plane — scenario {}",
+                scenario.name
+            ),
+            shapes: history.shapes.clone(),
+        };
+        written.extend(write_png_and_svg(
+            out,
+            SHAPE_STEM,
+            SHAPE_FIGURE_SIZE_PX,
+            &shapes,
+        )?);
+    }
     Ok(written)
+}
+
+/// The tether's shape at some instants, in the plane of the orbit: along-track (e_θ) against
+/// radial (e_r), km, relative to the main satellite, both axes on one scale; one curve per
+/// instant, its nodes (main satellite, beads, sub-satellite) as vertices.
+pub struct TetherShapes {
+    /// The figure's caption.
+    pub caption: String,
+    /// (t in s, node positions (e_r, e_θ, e_h) in m), as `History::shapes` holds them.
+    pub shapes: Vec<(f64, Vec<[f64; 3]>)>,
+}
+
+impl TetherShapes {
+    /// Each shape's (along-track, radial) vertices in km, the finite ones.
+    fn curves(&self) -> Vec<(f64, Vec<(f64, f64)>)> {
+        self.shapes
+            .iter()
+            .map(|(t_s, nodes)| {
+                let points = nodes
+                    .iter()
+                    .map(|n| (n[1] / M_PER_KM, n[0] / M_PER_KM))
+                    .filter(|p| p.0.is_finite() && p.1.is_finite())
+                    .collect();
+                (*t_s, points)
+            })
+            .collect()
+    }
+}
+
+/// The colour of curve `i` of `n`: hue from blue (first) to red (last).
+fn time_color(i: usize, n: usize) -> HSLColor {
+    let late = if n > 1 {
+        i as f64 / (n - 1) as f64
+    } else {
+        0.0
+    };
+    HSLColor(0.62 * (1.0 - late), 0.8, 0.42)
+}
+
+impl Figure for TetherShapes {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()> {
+        root.fill(&WHITE).map_err(draw_error)?;
+        let curves = self.curves();
+        let all = || curves.iter().flat_map(|c| c.1.iter()).chain([&(0.0, 0.0)]);
+        let (x0, x1) = padded_range(all().map(|p| p.0));
+        let (y0, y1) = padded_range(all().map(|p| p.1));
+        // One scale on both axes: widen the narrower range about its centre.
+        let half = 0.5 * (x1 - x0).max(y1 - y0);
+        let (xc, yc) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+        let mut chart = ChartBuilder::on(root)
+            .caption(&self.caption, (FONT, 22))
+            .margin(14)
+            .x_label_area_size(48)
+            .y_label_area_size(80)
+            .build_cartesian_2d(xc - half..xc + half, yc - half..yc + half)
+            .map_err(draw_error)?;
+        chart
+            .configure_mesh()
+            .x_desc("along-track e_θ (km)")
+            .y_desc("radial e_r (km)")
+            .label_style((FONT, 16))
+            .axis_desc_style((FONT, 18))
+            .light_line_style(RGBColor(0xee, 0xee, 0xee))
+            .draw()
+            .map_err(draw_error)?;
+        let n = curves.len();
+        let every = n.div_ceil(MAX_SHAPE_LABELS).max(1);
+        for (i, (t_s, points)) in curves.iter().enumerate() {
+            let color = time_color(i, n);
+            let drawn = chart
+                .draw_series(LineSeries::new(
+                    points.iter().copied(),
+                    color.stroke_width(2),
+                ))
+                .map_err(draw_error)?;
+            if i % every == 0 || i + 1 == n {
+                drawn
+                    .label(format!("t = {:.2} h", t_s / S_PER_H))
+                    .legend(move |(x, y)| {
+                        PathElement::new([(x, y), (x + 24, y)], color.stroke_width(2))
+                    });
+            }
+        }
+        chart
+            .draw_series([Circle::new((0.0, 0.0), 5, BLACK.filled())])
+            .map_err(draw_error)?
+            .label("main satellite")
+            .legend(|(x, y)| Circle::new((x + 12, y), 4, BLACK.filled()));
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font((FONT, 16))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(draw_error)?;
+        Ok(())
+    }
 }
 
 /// The panels of Figs. 4, 5 and 6.

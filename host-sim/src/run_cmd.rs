@@ -1,5 +1,6 @@
 //! `tss-sim run SCENARIO [--out DIR] [--set key=value]... [--pil [--firmware ELF]]`: simulate a
-//! mission and write its history, the paper's Figs. 4–6, the Table-1 comparison and a summary.
+//! mission and write its history, the paper's Figs. 4–6 (and on the elastic plant the tether's
+//! shape, `plots::TetherShapes`), the Table-1 comparison and a summary.
 //!
 //! Everything the user gave is checked (scenario, overrides, output directory, firmware) before
 //! the simulation starts; such errors are [`UsageError`] or [`ScenarioError`], which the binary
@@ -175,7 +176,10 @@ pub fn print_outcome(o: &RunOutcome) {
         let _ = writeln!(stdout, "  {}", p.display());
     }
     if o.figure_error.is_none() {
-        let _ = writeln!(stdout, "Figures (Figs. 4–6 of the paper):");
+        let _ = writeln!(
+            stdout,
+            "Figures (Figs. 4–6 of the paper; the tether's shape on the elastic plant):"
+        );
         for p in &o.figures {
             let _ = writeln!(stdout, "  {}", p.display());
         }

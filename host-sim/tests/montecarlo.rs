@@ -466,3 +466,46 @@ fn a_campaign_replaces_an_earlier_campaigns_files() {
     assert!(out.join("notes.md").exists());
     assert!(out.join("runs.csv").is_file());
 }
+
+/// A dispersion of a key the selected models ignore would report a spread that was never
+/// flown: with `reel.model = "motor"` the lag drive's keys, with the lag drive the drum's, on
+/// the rigid plant the elastic tether's. Refused (exit 2, naming the key and why).
+#[test]
+fn dispersing_a_key_the_models_ignore_is_refused() {
+    let paper = scenario();
+    let paper = paper.to_str().unwrap();
+    let elastic = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper-elastic.toml");
+    let elastic = elastic.to_str().unwrap();
+    let one = |field: &str| {
+        format!(
+            "montecarlo.dispersion=[{{ field = \"{field}\", distribution = \"uniform\", \
+             min = 0.5, max = 1.0 }}]"
+        )
+    };
+    for field in ["reel.lag_s", "reel.max_rate_mps", "reel.max_accel_mps2"] {
+        rejected(
+            &[elastic, "--runs", "2", "--set", &one(field)],
+            &[
+                &format!("montecarlo.dispersion[0].field = \"{field}\" has no effect"),
+                "reel.model = \"motor\"",
+            ],
+        );
+    }
+    for field in ["reel.drum_inertia_kgm2", "tether.axial_stiffness_n"] {
+        rejected(
+            &[paper, "--runs", "2", "--set", &one(field)],
+            &[&format!(
+                "montecarlo.dispersion[0].field = \"{field}\" has no effect"
+            )],
+        );
+    }
+    // The same keys are dispersible where a selected model reads them.
+    for (file, field) in [
+        (elastic, "reel.drum_inertia_kgm2"),
+        (elastic, "tether.axial_stiffness_n"),
+        (paper, "reel.lag_s"),
+    ] {
+        let loaded = tss_sim::scenario::Scenario::load(Path::new(file), &[one(field)]);
+        assert!(loaded.is_ok(), "{file} {field}: {:?}", loaded.err());
+    }
+}

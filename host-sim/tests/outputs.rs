@@ -372,3 +372,57 @@ fn a_failed_run_leaves_the_earlier_results_and_a_new_one_replaces_them_all() {
     );
     check_outputs(&out);
 }
+
+fn paper_elastic() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper-elastic.toml")
+}
+
+/// Issue 17: "a figure of the tether's shape at chosen times". An elastic run draws
+/// `tether_shape.png`/`.svg` (one curve per recorded shape, in the orbit plane) and lists it; a
+/// rigid run has no shape to draw, and run into the same directory it removes the earlier one.
+#[test]
+fn an_elastic_run_draws_the_tethers_shape_and_a_rigid_one_does_not() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("shape");
+    let run = |scenario: &Path| {
+        let o = Command::new(BIN)
+            .args(["run", scenario.to_str().unwrap(), "--out"])
+            .arg(&out)
+            .args(["--set", "simulation.duration_s=1800"])
+            .args(["--set", "plant.shape_interval_s=600"])
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+        assert!(
+            o.status.success(),
+            "{stdout}\n{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        stdout
+    };
+    let stdout = run(&paper_elastic());
+    for f in ["tether_shape.png", "tether_shape.svg"] {
+        assert!(
+            stdout.contains(&format!("{f}\n")),
+            "{f} not listed: {stdout}"
+        );
+    }
+    let png = std::fs::read(out.join("tether_shape.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    let svg = std::fs::read_to_string(out.join("tether_shape.svg")).unwrap();
+    assert!(svg.contains("along-track e_θ (km)") && svg.contains("radial e_r (km)"));
+    // Shapes at 0, 600, 1200 and 1800 s: a curve (and legend entry) each.
+    for t in ["t = 0.00 h", "t = 0.17 h", "t = 0.33 h", "t = 0.50 h"] {
+        assert!(svg.contains(t), "{t} not in the legend");
+    }
+    for f in FIGURES {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+
+    // Shape files are in the run's set: a rigid run into the same directory removes them.
+    let rigid = run(&paper());
+    assert!(!rigid.contains("tether_shape"), "{rigid}");
+    assert!(!out.join("tether_shape.png").exists());
+    assert!(!out.join("tether_shape.svg").exists());
+    assert!(out.join("fig4_length_tension.png").is_file());
+}

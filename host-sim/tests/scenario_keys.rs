@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use tss_sim::scenario::keys::{keys, KeyDefault, KeyInfo};
+use tss_sim::scenario::keys::{keys, KeyDefault, KeyInfo, DIMENSIONLESS_NAMES};
 use tss_sim::scenario::{schema, LeafKind, Scenario, ScenarioError};
 
 fn paper() -> PathBuf {
@@ -184,6 +184,43 @@ fn the_listing_states_the_rules_a_reader_relies_on() {
     assert_eq!(unit("controller.k2_per_s2"), "1/s²");
     assert_eq!(unit("sensors.alpha_rate.bias"), "rad/s");
     assert_eq!(unit("simulation.substeps"), "");
+    assert_eq!(unit("reel.coulomb_nm"), "N·m");
+    assert_eq!(unit("reel.viscous_nms"), "N·m·s/rad");
+    assert_eq!(unit("tether.damping_ns"), "N·s");
+    assert_eq!(unit("environment.main_drag_area_m2"), "m²");
+    assert_eq!(unit("reel.drum_inertia_kgm2"), "kg·m²");
+    assert_eq!(unit("faults.corrupt[].value"), "sensor's unit");
+    assert_eq!(unit("montecarlo.dispersion[].std"), "field's unit");
+}
+
+/// Every number key has a unit, unless its name says it has none (a ratio, coefficient or
+/// count of [`DIMENSIONLESS_NAMES`]): a key whose suffix the unit table does not know (say a
+/// new `_nm` before `_nm` was added) fails here. Text, switches and choices have none.
+#[test]
+fn every_number_key_has_a_known_unit_or_is_dimensionless_by_name() {
+    for k in keys() {
+        let number = matches!(k.kind, LeafKind::Float | LeafKind::Integer { .. });
+        let name = k.key.rsplit('.').next().unwrap();
+        if number && k.unit.is_empty() {
+            assert!(
+                DIMENSIONLESS_NAMES.contains(&name),
+                "{} has no unit and is not dimensionless by name",
+                k.key
+            );
+        }
+        if !number {
+            assert_eq!(k.unit, "", "{} is not a number but has a unit", k.key);
+        }
+    }
+    // The dimensionless names are keys that exist and have no unit.
+    let all = keys();
+    for name in DIMENSIONLESS_NAMES {
+        assert!(
+            all.iter()
+                .any(|k| k.key.ends_with(&format!(".{name}")) && k.unit.is_empty()),
+            "{name}"
+        );
+    }
 }
 
 #[test]

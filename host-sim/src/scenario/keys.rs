@@ -56,7 +56,7 @@ pub struct KeyInfo {
     pub schema_key: String,
     /// Its type.
     pub kind: LeafKind,
-    /// Its unit, read from its name (`_m`, `_mps`, …); empty when it has none.
+    /// Its unit, read from its name (`_m`, `_mps`, …) by [`unit_of`]; empty when it has none.
     pub unit: &'static str,
     /// Its default.
     pub default: KeyDefault,
@@ -347,8 +347,20 @@ fn masked(message: &str) -> String {
     out
 }
 
-/// The unit in a key's name, by the naming convention (`_m`, `_mps`, `_rad_per_m`, …).
+/// The names of the number keys that have no unit: ratios, coefficients and counts (the last
+/// part of the key; `tss-sim scenario keys` shows "-" for them).
+pub const DIMENSIONLESS_NAMES: [&str; 5] = [
+    "eccentricity",
+    "courant",
+    "drag_coefficient",
+    "seed",
+    "substeps",
+];
+
+/// The unit in a key's name, by the naming convention (`_m`, `_mps`, `_rad_per_m`, `_nm`, …);
+/// empty for a key without one (text, switches, [`DIMENSIONLESS_NAMES`]).
 pub fn unit_of(key: &str) -> &'static str {
+    // Longest first where one suffix ends another (`_kgm2` before `_m2`).
     const SUFFIXES: &[(&str, &str)] = &[
         ("_kg_per_m", "kg/m"),
         ("_rad_per_m", "rad/m"),
@@ -357,6 +369,11 @@ pub fn unit_of(key: &str) -> &'static str {
         ("_radps", "rad/s"),
         ("_mps2", "m/s²"),
         ("_mps", "m/s"),
+        ("_kgm2", "kg·m²"),
+        ("_m2", "m²"),
+        ("_nms", "N·m·s/rad"),
+        ("_nm", "N·m"),
+        ("_ns", "N·s"),
         ("_kg", "kg"),
         ("_rad", "rad"),
         ("_n", "N"),
@@ -369,11 +386,18 @@ pub fn unit_of(key: &str) -> &'static str {
     if let Some((_, unit)) = SUFFIXES.iter().find(|(s, _)| name.ends_with(s)) {
         return unit;
     }
-    // A sensor's errors are in the sensor's unit.
+    // A sensor's errors are in the sensor's unit; so is an injected corrupt value, and a
+    // dispersion's parameters are in the unit of the field it disperses.
     match key.rsplit_once('.').map(|(section, _)| section) {
         Some("sensors.length") => "m",
         Some("sensors.alpha") => "rad",
         Some("sensors.alpha_rate") => "rad/s",
+        Some("faults.corrupt[]" | "faults.corrupt") if name == "value" => "sensor's unit",
+        Some("montecarlo.dispersion[]" | "montecarlo.dispersion")
+            if matches!(name, "mean" | "std" | "min" | "max") =>
+        {
+            "field's unit"
+        }
         _ => "",
     }
 }

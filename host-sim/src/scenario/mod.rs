@@ -72,8 +72,8 @@ pub use link::LinkSection;
 pub use monitor::MonitorSection;
 pub(crate) use montecarlo::nominal_in;
 pub use montecarlo::{
-    dispersible_fields, nominal_value, CriteriaSection, DispersionSection, Distribution,
-    MonteCarloSection,
+    dispersible_fields, ignored_by_models, nominal_value, CriteriaSection, DispersionSection,
+    Distribution, MonteCarloSection,
 };
 pub use plant::{PlantModel, PlantSection, SensedDirection};
 pub use reel::{ReelModelName, ReelSection};

@@ -4,6 +4,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::plant::PlantModel;
+use super::reel::ReelModelName;
 use super::rules::{num, Validator};
 use super::schema::{schema, LeafKind};
 use super::Scenario;
@@ -209,12 +211,77 @@ impl MonteCarloSection {
                     "is dispersed twice",
                 );
                 seen.push(&d.field);
+                if let Some(why) = ignored_by_models(sc, &d.field) {
+                    v.check(
+                        false,
+                        &field,
+                        format!("{:?}", d.field),
+                        &format!("has no effect on this scenario: {why}"),
+                    );
+                    continue;
+                }
                 let nominal = table.as_ref().and_then(|t| nominal_in(t, &d.field));
                 d.check(&at, nominal, v);
             }
         }
         self.criteria.check(v);
     }
+}
+
+/// Why the models `sc` selects ignore the number field `field` (`None`: one of them uses it).
+/// A dispersion of such a field would change nothing, so a campaign that asks for one is
+/// refused rather than reporting a spread that was never flown.
+pub fn ignored_by_models(sc: &Scenario, field: &str) -> Option<String> {
+    const LAG_DRIVE: [&str; 3] = ["reel.lag_s", "reel.max_rate_mps", "reel.max_accel_mps2"];
+    const MOTOR: [&str; 8] = [
+        "reel.drum_radius_m",
+        "reel.drum_inertia_kgm2",
+        "reel.viscous_nms",
+        "reel.coulomb_nm",
+        "reel.static_nm",
+        "reel.motor_max_torque_nm",
+        "reel.brake_nm",
+        "reel.speed_bandwidth_radps",
+    ];
+    // Read by the elastic plant only (the rigid one uses tether.density_kg_per_m alone).
+    const ELASTIC_ONLY: [&str; 7] = [
+        "plant.courant",
+        "plant.shape_interval_s",
+        "tether.axial_stiffness_n",
+        "tether.damping_ns",
+        "tether.segment_length_m",
+        "tether.min_stiffness_length_m",
+        "environment.inclination_rad",
+    ];
+    const DRAG: [&str; 4] = [
+        "environment.main_drag_area_m2",
+        "environment.sub_drag_area_m2",
+        "tether.diameter_m",
+        "tether.drag_coefficient",
+    ];
+    let rigid = sc.plant.model == PlantModel::Rigid;
+    if rigid && (ELASTIC_ONLY.contains(&field) || DRAG.contains(&field)) {
+        return Some("the rigid plant (plant.model = \"rigid\") does not use it".to_string());
+    }
+    if sc.reel.model == ReelModelName::Motor && LAG_DRIVE.contains(&field) {
+        return Some(
+            "reel.model = \"motor\" flies the drum and its speed loop, not the lag drive"
+                .to_string(),
+        );
+    }
+    if sc.reel.model == ReelModelName::Drive && MOTOR.contains(&field) {
+        return Some(
+            "reel.model = \"drive\" has no drum (the motor keys need \"motor\")".to_string(),
+        );
+    }
+    if DRAG.contains(&field) && !sc.environment.drag {
+        return Some("environment.drag = false".to_string());
+    }
+    // Without J2 or drag gravity is central: the plane's tilt changes nothing.
+    if field == "environment.inclination_rad" && !sc.environment.j2 && !sc.environment.drag {
+        return Some("environment.j2 and environment.drag are both false".to_string());
+    }
+    None
 }
 
 /// The dispersible fields in the section of `field`, or a few examples.
