@@ -182,3 +182,41 @@ fn bad_command_line_arguments_exit_2() {
     assert_eq!(o.status.code(), Some(2));
     assert!(std::fs::read_dir(tmp.path()).unwrap().next().is_none());
 }
+
+#[test]
+fn a_file_larger_than_any_scenario_is_not_read_and_exits_2() {
+    // The paper's scenario padded with comments past the bound: valid TOML, too large.
+    let tmp = tempfile::tempdir().unwrap();
+    let big = tmp.path().join("big.toml");
+    let mut text = std::fs::read_to_string(paper()).unwrap();
+    let line = "# padding\n";
+    let max = tss_sim::scenario::MAX_SCENARIO_BYTES as usize;
+    text.push_str(&line.repeat(max / line.len() + 1));
+    std::fs::write(&big, text).unwrap();
+    rejected(&big, &[], &["big.toml", "larger than 1048576 bytes"]);
+
+    // A device that never ends is read no further than the bound (it hung before).
+    let zero = Path::new("/dev/zero");
+    if zero.exists() {
+        let mut child = Command::new(BIN)
+            .args(["run", "/dev/zero", "--out"])
+            .arg(tmp.path().join("out"))
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .expect("tss-sim runs");
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+        let status = loop {
+            if let Some(status) = child.try_wait().unwrap() {
+                break Some(status);
+            }
+            if std::time::Instant::now() > deadline {
+                child.kill().unwrap();
+                child.wait().unwrap();
+                break None;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        };
+        assert_eq!(status.and_then(|s| s.code()), Some(2), "run /dev/zero");
+    }
+}

@@ -301,12 +301,20 @@ fn usage(msg: String) -> anyhow::Error {
 fn read_shard(dir: &Path) -> anyhow::Result<ShardDir> {
     let d = dir.display();
     let path = dir.join(CAMPAIGN_TOML);
-    let text = std::fs::read_to_string(&path).map_err(|e| {
-        usage(format!(
-            "{d}: not the output of `tss-sim montecarlo` (cannot read {}: {e})",
-            path.display()
-        ))
-    })?;
+    let text = crate::scenario::read_bounded(&path, crate::scenario::MAX_SCENARIO_BYTES)
+        .map_err(|e| {
+            usage(format!(
+                "{d}: not the output of `tss-sim montecarlo` (cannot read {}: {e})",
+                path.display()
+            ))
+        })?
+        .ok_or_else(|| {
+            usage(format!(
+                "{}: larger than {} bytes: not a campaign manifest",
+                path.display(),
+                crate::scenario::MAX_SCENARIO_BYTES
+            ))
+        })?;
     let manifest: Manifest = toml::from_str(&text).map_err(|e| {
         usage(format!(
             "{}: not a campaign manifest: {}",

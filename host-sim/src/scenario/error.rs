@@ -15,6 +15,15 @@ pub enum ScenarioError {
         #[source]
         error: std::io::Error,
     },
+    /// The file is larger than any scenario ([`MAX_SCENARIO_BYTES`](super::MAX_SCENARIO_BYTES)):
+    /// not read further (a device such as `/dev/zero` would otherwise be read for ever).
+    #[error("{file}: larger than {max_bytes} bytes: not a scenario file")]
+    TooLarge {
+        /// The scenario file, as given.
+        file: String,
+        /// The bound, bytes.
+        max_bytes: u64,
+    },
     /// The file is not valid TOML.
     #[error("{file}: not valid TOML: {message}")]
     Syntax {

@@ -2,11 +2,26 @@
 //! `--set key=value` overrides applied on top, then deserialization and validation.
 
 use std::collections::BTreeSet;
+use std::io::Read;
 use std::path::Path;
 
 use super::error::ScenarioError;
 use super::schema::{schema, LeafKind, Schema};
 use super::Scenario;
+
+/// The largest scenario file read, bytes: the paper's scenarios are 2–6 KiB; a file of fault
+/// lists at their bounds stays well under this.
+pub const MAX_SCENARIO_BYTES: u64 = 1 << 20;
+
+/// The text of the file at `path` if it has at most `max_bytes` bytes, `None` if it has more
+/// (it is not read beyond `max_bytes + 1`: a device or a huge file costs nothing).
+pub fn read_bounded(path: &Path, max_bytes: u64) -> std::io::Result<Option<String>> {
+    let mut text = String::new();
+    std::fs::File::open(path)?
+        .take(max_bytes + 1)
+        .read_to_string(&mut text)?;
+    Ok((text.len() as u64 <= max_bytes).then_some(text))
+}
 
 impl Scenario {
     /// Reads a scenario file, applies `--set key=value` overrides (dotted keys, values parsed as
@@ -21,10 +36,16 @@ impl Scenario {
     pub fn load(path: impl AsRef<Path>, overrides: &[String]) -> Result<Scenario, ScenarioError> {
         let path = path.as_ref();
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|error| ScenarioError::Io {
+        let io = |error| ScenarioError::Io {
             file: file.clone(),
             error,
-        })?;
+        };
+        let text = read_bounded(path, MAX_SCENARIO_BYTES)
+            .map_err(io)?
+            .ok_or_else(|| ScenarioError::TooLarge {
+                file: file.clone(),
+                max_bytes: MAX_SCENARIO_BYTES,
+            })?;
         Self::from_toml_str(&text, &file, overrides)
     }
 

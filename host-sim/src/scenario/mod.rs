@@ -69,6 +69,7 @@ pub use environment::EnvironmentSection;
 pub use error::{Problem, ScenarioError};
 pub use initial::InitialSection;
 pub use link::LinkSection;
+pub use load::{read_bounded, MAX_SCENARIO_BYTES};
 pub use monitor::MonitorSection;
 pub(crate) use montecarlo::nominal_in;
 pub use montecarlo::{
