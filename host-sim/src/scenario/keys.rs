@@ -349,12 +349,13 @@ fn masked(message: &str) -> String {
 
 /// The names of the number keys that have no unit: ratios, coefficients and counts (the last
 /// part of the key; `tss-sim scenario keys` shows "-" for them).
-pub const DIMENSIONLESS_NAMES: [&str; 5] = [
+pub const DIMENSIONLESS_NAMES: [&str; 6] = [
     "eccentricity",
     "courant",
     "drag_coefficient",
     "seed",
     "substeps",
+    "good_samples_per_bad",
 ];
 
 /// The unit in a key's name, by the naming convention (`_m`, `_mps`, `_rad_per_m`, `_nm`, …);
