@@ -37,134 +37,22 @@ use tss_reel::recordings::mission;
 
 mod bench {
     use core::hint::black_box;
-    use cortex_m::peripheral::{syst::SystClkSource, SYST};
     use nalgebra::{Matrix3, Vector3};
     use tss_reel::estimator::{Config, Drive, Estimator, Measurement};
+    pub use tss_reel::firmware::bench::{Meter, Stats, INSTRUCTIONS_PER_COUNT, K};
 
-    /// Copies of the state each measurement runs on; the result is divided by this.
-    pub const K: usize = 16;
-
-    /// Instructions per SysTick count: 25 MHz processor clock, 1 ns per instruction.
-    pub const INSTRUCTIONS_PER_COUNT: u32 = 40;
-
-    /// SysTick's reload value: the full 24-bit range.
-    const RELOAD: u32 = 0x00FF_FFFF;
-
-    /// The free-running SysTick (no interrupt), counting processor clocks.
-    pub struct Meter {
-        _syst: SYST,
-        overhead_instructions: u32,
-    }
-
-    impl Meter {
-        /// Starts SysTick on the processor clock and calibrates the loop overhead.
-        pub fn start(mut syst: SYST) -> Self {
-            syst.disable_interrupt();
-            syst.set_clock_source(SystClkSource::Core);
-            syst.set_reload(RELOAD);
-            syst.clear_current();
-            syst.enable_counter();
-            let mut m = Self {
-                _syst: syst,
-                overhead_instructions: 0,
-            };
-            let mut empty = [0_u32; K];
-            let mut least = u32::MAX;
-            for _ in 0..8 {
-                least = least.min(m.raw(&mut empty, |_| ()));
-            }
-            m.overhead_instructions = least;
-            m
-        }
-
-        /// Instructions of `K` calls of `f`, one per state, loop included.
-        #[inline(never)]
-        fn raw<S, R>(&self, states: &mut [S; K], mut f: impl FnMut(&mut S) -> R) -> u32 {
-            let t0 = SYST::get_current();
-            for s in states.iter_mut() {
-                let r = f(black_box(s));
-                black_box(&r);
-            }
-            let t1 = SYST::get_current();
-            (t0.wrapping_sub(t1) & RELOAD) * INSTRUCTIONS_PER_COUNT
-        }
-
-        /// Instructions of one call of `f`: `K` calls on `K` copies, loop subtracted, ÷ `K`.
-        pub fn per_call<S, R>(&self, states: &mut [S; K], f: impl FnMut(&mut S) -> R) -> u32 {
-            let total = self
-                .raw(states, f)
-                .saturating_sub(self.overhead_instructions);
-            (total + K as u32 / 2) / K as u32
-        }
-
-        /// Instructions measured around a delay loop of 2n + 2 instructions (clock check).
-        pub fn instructions_of_delay(&self, n: u32) -> u32 {
-            let t0 = SYST::get_current();
-            cortex_m::asm::delay(n);
-            let t1 = SYST::get_current();
-            (t0.wrapping_sub(t1) & RELOAD) * INSTRUCTIONS_PER_COUNT
-        }
-    }
-
-    /// Distribution of per-step counts: exact up to `BINS - 1`, then lumped.
-    pub struct Stats<const BINS: usize> {
-        hist: [u32; BINS],
-        n: u32,
-        sum: u64,
-        max: (u32, u32),
-    }
-
-    impl<const BINS: usize> Stats<BINS> {
-        pub const fn new() -> Self {
-            Self {
-                hist: [0; BINS],
-                n: 0,
-                sum: 0,
-                max: (0, 0),
-            }
-        }
-
-        pub fn add(&mut self, v: u32, tick: u32) {
-            self.hist[(v as usize).min(BINS - 1)] += 1;
-            self.n += 1;
-            self.sum += u64::from(v);
-            if v > self.max.0 || self.n == 1 {
-                self.max = (v, tick);
-            }
-        }
-
-        /// The smallest value with at least `per_mille`‰ of the counts at or below it.
-        pub fn quantile(&self, per_mille: u32) -> u32 {
-            let need = (u64::from(self.n) * u64::from(per_mille))
-                .div_ceil(1000)
-                .max(1);
-            let mut acc = 0_u64;
-            for (v, &c) in self.hist.iter().enumerate() {
-                acc += u64::from(c);
-                if acc >= need {
-                    return v as u32;
-                }
-            }
-            BINS as u32 - 1
-        }
-
-        pub fn report(&self, what: &str) {
-            let mean = if self.n == 0 {
-                0
-            } else {
-                (self.sum / u64::from(self.n)) as u32
-            };
-            defmt::info!(
-                "{=str}: {=u32} steps: median {=u32}, p99 {=u32}, worst {=u32} (tick {=u32}), mean {=u32} instructions",
-                what,
-                self.n,
-                self.quantile(500),
-                self.quantile(990),
-                self.max.0,
-                self.max.1,
-                mean
-            );
-        }
+    /// Logs the distribution of one kind of step.
+    pub fn report<const BINS: usize>(s: &Stats<BINS>, what: &str) {
+        defmt::info!(
+            "{=str}: {=u32} steps: median {=u32}, p99 {=u32}, worst {=u32} (tick {=u32}), mean {=u32} instructions",
+            what,
+            s.n,
+            s.median(),
+            s.quantile(990),
+            s.max.0,
+            s.max.1,
+            s.mean()
+        );
     }
 
     /// A small deterministic noise source (xorshift32), uniform in ±√3 σ (σ = 1e-4 rad).
@@ -242,9 +130,18 @@ mod bench {
             };
             outcomes[i] += 1;
         }
-        with_sample.report("Estimator::step, sample accepted or gated (every tick)");
-        dropout.report("Estimator::step, dropout (prediction only, every 97th tick)");
-        gated.report("Estimator::step, 0.05 rad outlier gated (every 97th tick)");
+        report(
+            &with_sample,
+            "Estimator::step, sample accepted or gated (every tick)",
+        );
+        report(
+            &dropout,
+            "Estimator::step, dropout (prediction only, every 97th tick)",
+        );
+        report(
+            &gated,
+            "Estimator::step, 0.05 rad outlier gated (every 97th tick)",
+        );
         defmt::info!(
             "mission outcomes: {=u32} accepted, {=u32} gated, {=u32} other",
             outcomes[0],

@@ -11,7 +11,8 @@
 //!   the main loop does not change when it is;
 //! - [`pil`]: the processor-in-the-loop mission over UART0 ([`uart`]), selected by `pil` on the
 //!   semihosting command line ([`cmdline`]; QEMU `-append pil`);
-//! - [`stack`]: the stack high-water mark (the stack is painted by cortex-m-rt at reset).
+//! - [`stack`]: the stack high-water mark (the stack is painted by cortex-m-rt at reset);
+//! - [`bench`]: instruction counting for the on-target benchmarks (`scripts/bench-target`).
 //!
 //! This module also links the two runtime crates that have no API to call:
 //! - `defmt-semihosting` is the global defmt logger (frames go out through semihosting stdout);
@@ -22,6 +23,7 @@
 use defmt_semihosting as _;
 use panic_probe as _;
 
+pub mod bench;
 pub mod clock;
 pub mod cmdline;
 pub mod exit;
