@@ -12,7 +12,7 @@
 //! - [`pil`]: the processor-in-the-loop mission over UART0 ([`uart`]), selected by `pil` on the
 //!   semihosting command line ([`cmdline`]; QEMU `-append pil`);
 //! - [`stack`]: the stack high-water mark (the stack is painted by cortex-m-rt at reset);
-//! - [`bench`]: instruction counting for the on-target benchmarks (`scripts/bench-target`).
+//! - [`bench`](mod@bench): instruction counting for the on-target benchmarks (`scripts/bench-target`).
 //!
 //! This module also links the two runtime crates that have no API to call:
 //! - `defmt-semihosting` is the global defmt logger (frames go out through semihosting stdout);
