@@ -220,3 +220,22 @@ fn a_file_larger_than_any_scenario_is_not_read_and_exits_2() {
         assert_eq!(status.and_then(|s| s.code()), Some(2), "run /dev/zero");
     }
 }
+
+#[test]
+fn a_gain_too_fast_for_the_control_period_exits_2_and_says_why() {
+    // k1 = 1e30 once passed validation and flew a 4 m tether to a claimed "2 km at 8.000 h".
+    rejected(
+        &paper(),
+        &["--set", "controller.k1_per_s=1e30"],
+        &[
+            "controller.k1_per_s = 1e30",
+            "too fast for controller.period_s = 1 s",
+            "Eq. 28",
+        ],
+    );
+    rejected(
+        &paper(),
+        &["--set", "controller.period_s=1e-4"],
+        &["controller.period_s", "must be at least 0.001 s"],
+    );
+}

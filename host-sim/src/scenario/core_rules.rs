@@ -148,6 +148,20 @@ fn message(sc: &Scenario, e: &ConfigError, key: &str, x: f64) -> String {
             num(sc.masses.main_initial_kg)
         ),
         Rule::NoEquilibrium => "leaves no equilibrium over the whole orbit (Eq. 13)".to_string(),
+        Rule::BelowMinimum => format!(
+            "must be at least {} s (tss_reel::config::MIN_PERIOD_S)",
+            num(tss_reel::config::MIN_PERIOD_S)
+        ),
+        Rule::TooFastForPeriod => format!(
+            "is too fast for controller.period_s = {} s: the fastest Eq. 28 closed-loop pole (k1, \
+             k2) or blend rate c, times the period, must be at most {} \
+             (tss_reel::config::MAX_POLE_PERIOD_PRODUCT)",
+            num(sc.controller.period_s),
+            num(tss_reel::config::MAX_POLE_PERIOD_PRODUCT)
+        ),
+        Rule::TooLarge => "is so large that monitor.coast_ticks × monitor.good_samples_per_bad \
+                           overflows a 32-bit count"
+            .to_string(),
         // A rule the controller learns after this mapping was written.
         #[allow(unreachable_patterns)]
         other => format!("breaks the controller's rule {other:?}"),
