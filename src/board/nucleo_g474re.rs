@@ -34,12 +34,12 @@
 //! which the spacecraft's other sensors provide (a serial link later, as the QEMU build's PIL
 //! link does). Until then they come from **the recorded mission**
 //! ([`tss_reel::recordings::replay`]: the first 720 s of `scenarios/paper.toml` as the reel
-//! MCU senses it, with its injected 50 s dropout), exactly as the QEMU firmware's replay, and the
-//! paper's circular orbit rate. The drum on the bench therefore runs the paper's reel-rate
-//! profile against whatever load it has; the log shows, once a law period, the commanded rate,
-//! the drum's measured speed and paid-out length (from the encoder), and the tension (from the
-//! load cell). When the replay ends the drive is put in safe hold (brake engaged, motor off) and
-//! the inner loop keeps holding it.
+//! MCU senses it, with its injected 50 s dropout, and the paper's circular orbit rate), read
+//! through the QEMU firmware's sensor type, `tss_reel::recordings::sensors::Replay`. The drum on
+//! the bench therefore runs the paper's reel-rate profile against whatever load it has; the log
+//! shows, once a law period, the commanded rate, the drum's measured speed and paid-out length
+//! (from the encoder), and the tension (from the load cell). When the replay ends the drive is
+//! put in safe hold (brake engaged, motor off) and the inner loop keeps holding it.
 //!
 //! ## Faults
 //! A panic (panic-probe logs it) or any fault ends in [`HardFault`], which logs and resets the
@@ -79,13 +79,13 @@ mod board {
     use stm32g4xx_hal::time::RateExtU32;
 
     use tss_reel::controller::{Config, Controller};
-    use tss_reel::hal::{
-        control_cycle, Devices, ErrorKind, ErrorType, LengthSensor, OrbitRateSource, ReelDrive,
-        Swing, SwingSensor,
-    };
+    use tss_reel::hal::{control_cycle, Devices, ErrorKind, ErrorType, ReelDrive};
     use tss_reel::recordings::replay::{
         DROPOUT_FROM_TICK, DROPOUT_UNTIL_TICK, ORBIT_RATE_RADPS, PERIOD_S, SAMPLES,
     };
+    // The outer law's sensors that the board does not have: the recorded mission (see the
+    // crate docs), with its injected dropout, as the QEMU firmware's replay.
+    use tss_reel::recordings::sensors::Replay;
     use tss_reel::reel_drive::hal::{HalReelDrive, LoadCell, MotorPins, QuadratureEncoder};
     use tss_reel::reel_drive::{DriveConfig, RateCommand, SpeedLoop};
 
@@ -240,51 +240,6 @@ mod board {
         }
     }
 
-    /// The outer law's sensors that the board does not have: the recorded mission (see the
-    /// crate docs), with its injected dropout.
-    struct Recording;
-
-    impl Recording {
-        fn sample(tick: u32) -> Result<&'static [f32; 3], ErrorKind> {
-            if (DROPOUT_FROM_TICK..DROPOUT_UNTIL_TICK).contains(&tick) {
-                return Err(ErrorKind::NoSample);
-            }
-            SAMPLES.get(tick as usize).ok_or(ErrorKind::NoSample)
-        }
-    }
-
-    impl ErrorType for Recording {
-        type Error = ErrorKind;
-    }
-
-    impl LengthSensor for Recording {
-        fn read_length_m(&mut self, tick: u32) -> Result<f32, ErrorKind> {
-            Self::sample(tick).map(|s| s[0])
-        }
-    }
-
-    impl SwingSensor for Recording {
-        fn read_swing(&mut self, tick: u32) -> Result<Swing, ErrorKind> {
-            Self::sample(tick).map(|s| Swing {
-                alpha_rad: s[1],
-                alpha_rate_radps: s[2],
-            })
-        }
-    }
-
-    /// The paper's circular orbit.
-    struct CircularOrbit;
-
-    impl ErrorType for CircularOrbit {
-        type Error = ErrorKind;
-    }
-
-    impl OrbitRateSource for CircularOrbit {
-        fn read_orbit_rate_radps(&mut self, _tick: u32) -> Result<f32, ErrorKind> {
-            Ok(ORBIT_RATE_RADPS)
-        }
-    }
-
     /// The outer loop's view of the reel: it keeps the law's latest command for the main loop
     /// to hand to the speed loop.
     struct CommandLatch {
@@ -305,7 +260,7 @@ mod board {
     /// The outer loop's state.
     struct Outer {
         controller: Controller<f32>,
-        devices: Devices<Recording, Recording, CircularOrbit, CommandLatch>,
+        devices: Devices<Replay, Replay, Replay, CommandLatch>,
     }
 
     impl Outer {
@@ -413,9 +368,9 @@ mod board {
         let mut outer = Outer {
             controller,
             devices: Devices {
-                length: Recording,
-                swing: Recording,
-                orbit: CircularOrbit,
+                length: Replay,
+                swing: Replay,
+                orbit: Replay,
                 reel: CommandLatch { latest: None },
             },
         };

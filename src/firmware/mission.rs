@@ -4,7 +4,8 @@
 //! The built-in test input ([`tss_reel::recordings::replay`]) is the first 720 s of `scenarios/paper.toml`
 //! as the reel MCU senses it, recorded from `tss-sim`, with a sensor dropout injected at ticks
 //! 400..450 (longer than the controller's 30-tick coast, so it goes Degraded → SafeHold and
-//! recovers). The replay implements the [`tss_reel::hal`] sensor traits; the reel drive is a
+//! recovers). The replay ([`tss_reel::recordings::sensors::Replay`], shared with the
+//! NUCLEO-G474RE firmware) implements the [`tss_reel::hal`] sensor traits; the reel drive is a
 //! telemetry sink that folds every command into a digest. The controller is the flight one:
 //! `tss_reel::controller::Controller<f32>` with the paper's configuration, stepped once per
 //! SysTick through [`tss_reel::hal::control_cycle`].
@@ -20,14 +21,12 @@
 //! bit for bit against the same core compiled for the host by `tests/firmware_replay.rs`.
 
 use tss_reel::controller::{Config, Controller, Output};
-use tss_reel::hal::{
-    control_cycle, Cycle, Devices, ErrorKind, ErrorType, LengthSensor, OrbitRateSource, ReelDrive,
-    Swing, SwingSensor,
-};
+use tss_reel::hal::{control_cycle, Cycle, Devices, ErrorKind, ErrorType, ReelDrive};
 use tss_reel::link::{fnv1a_f32, fnv1a_start};
 use tss_reel::recordings::replay::{
     DROPOUT_FROM_TICK, DROPOUT_UNTIL_TICK, ORBIT_RATE_RADPS, PERIOD_S, SAMPLES,
 };
+use tss_reel::recordings::sensors::Replay;
 
 /// Control period, ms: 1 s, the period of the paper's scenario and of the recording.
 pub const CONTROL_PERIOD_MS: u32 = 1_000;
@@ -52,50 +51,6 @@ pub enum Flow {
     Finished,
     /// Something is wrong (it has been logged): exit with failure.
     Failed,
-}
-
-/// The recorded sensors, with the injected dropout.
-struct Replay;
-
-impl Replay {
-    fn sample(tick: u32) -> Result<&'static [f32; 3], ErrorKind> {
-        if (DROPOUT_FROM_TICK..DROPOUT_UNTIL_TICK).contains(&tick) {
-            return Err(ErrorKind::NoSample);
-        }
-        SAMPLES.get(tick as usize).ok_or(ErrorKind::NoSample)
-    }
-}
-
-impl ErrorType for Replay {
-    type Error = ErrorKind;
-}
-
-impl LengthSensor for Replay {
-    fn read_length_m(&mut self, tick: u32) -> Result<f32, ErrorKind> {
-        Self::sample(tick).map(|s| s[0])
-    }
-}
-
-impl SwingSensor for Replay {
-    fn read_swing(&mut self, tick: u32) -> Result<Swing, ErrorKind> {
-        Self::sample(tick).map(|s| Swing {
-            alpha_rad: s[1],
-            alpha_rate_radps: s[2],
-        })
-    }
-}
-
-/// The orbit rate of the paper's circular orbit.
-struct CircularOrbit;
-
-impl ErrorType for CircularOrbit {
-    type Error = ErrorKind;
-}
-
-impl OrbitRateSource for CircularOrbit {
-    fn read_orbit_rate_radps(&mut self, _tick: u32) -> Result<f32, ErrorKind> {
-        Ok(ORBIT_RATE_RADPS)
-    }
 }
 
 /// The reel drive of the replay: a telemetry sink that checks and fingerprints each command.
@@ -125,7 +80,7 @@ impl ReelDrive for TelemetryReel {
 /// The mission's state between ticks.
 pub struct Mission {
     controller: Controller<f32>,
-    devices: Devices<Replay, Replay, CircularOrbit, TelemetryReel>,
+    devices: Devices<Replay, Replay, Replay, TelemetryReel>,
 }
 
 impl Mission {
@@ -145,7 +100,7 @@ impl Mission {
             devices: Devices {
                 length: Replay,
                 swing: Replay,
-                orbit: CircularOrbit,
+                orbit: Replay,
                 reel: TelemetryReel {
                     digest: fnv1a_start(),
                     count: 0,

@@ -6,10 +6,13 @@
 //!   input (with an injected sensor dropout), also the first sequence of the target benchmark
 //!   and of the f32-vs-f64 accuracy test;
 //! - [`mission`]: the whole 20 hours, recorded every 5 s and interpolated back to 1 s: the
-//!   benchmarks (target and desk) and the accuracy test.
+//!   benchmarks (target and desk) and the accuracy test;
+//! - [`sensors`]: [`replay`] as the reel MCU's sensors ([`crate::hal`] traits, with the
+//!   dropout): the outer law's sensor source of both firmwares (QEMU and NUCLEO-G474RE).
 //!
-//! Feature `recordings` (on by default). Nothing here is linked into a program that does not
-//! use it.
+//! Feature `recordings` (on by default). Data, and the one device that reads it; nothing here is linked into
+//! a program that does not use it.
 
 pub mod mission;
 pub mod replay;
+pub mod sensors;
