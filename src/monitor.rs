@@ -152,35 +152,39 @@ impl<T: Real> Monitor<T> {
                 return Err(Sensor::LengthJump);
             }
         }
-        let (mut same_alpha_count, mut implied_motion_rad) = (1, T::ZERO);
-        if let Some(last) = &mut self.last {
-            // At least one tick's allowance (a repeated tick predicts no motion).
-            let ticks = T::from_u32(x.tick.wrapping_sub(last.tick).max(1));
-            let predicted = last.alpha_rad + last.alpha_rate_radps * (ticks * period_s);
-            if (x.alpha_rad - predicted).abs() > cfg.alpha_jump_rad * ticks {
-                return Err(Sensor::AlphaJump);
-            }
-            // Stuck: the same reading again and again while α̇ says it should have moved.
-            if x.alpha_rad == last.alpha_rad {
-                last.same_alpha_count = last.same_alpha_count.saturating_add(1);
-                last.implied_motion_rad =
-                    last.implied_motion_rad + x.alpha_rate_radps.abs() * period_s;
-                if last.same_alpha_count >= cfg.stuck_ticks
-                    && last.implied_motion_rad >= cfg.stuck_motion_rad
-                {
-                    return Err(Sensor::AlphaStuck);
-                }
-                (same_alpha_count, implied_motion_rad) =
-                    (last.same_alpha_count, last.implied_motion_rad);
-            }
+        let Some(last) = &mut self.last else {
+            self.last = Some(Accepted {
+                tick: x.tick,
+                alpha_rad: x.alpha_rad,
+                alpha_rate_radps: x.alpha_rate_radps,
+                same_alpha_count: 1,
+                implied_motion_rad: T::ZERO,
+            });
+            return Ok(());
+        };
+        // At least one tick's allowance (a repeated tick predicts no motion).
+        let ticks = T::from_u32(x.tick.wrapping_sub(last.tick).max(1));
+        let predicted = last.alpha_rad + last.alpha_rate_radps * (ticks * period_s);
+        if (x.alpha_rad - predicted).abs() > cfg.alpha_jump_rad * ticks {
+            return Err(Sensor::AlphaJump);
         }
-        self.last = Some(Accepted {
-            tick: x.tick,
-            alpha_rad: x.alpha_rad,
-            alpha_rate_radps: x.alpha_rate_radps,
-            same_alpha_count,
-            implied_motion_rad,
-        });
+        // Stuck: the same reading again and again while α̇ says it should have moved.
+        if x.alpha_rad == last.alpha_rad {
+            last.same_alpha_count = last.same_alpha_count.saturating_add(1);
+            last.implied_motion_rad = last.implied_motion_rad + x.alpha_rate_radps.abs() * period_s;
+            if last.same_alpha_count >= cfg.stuck_ticks
+                && last.implied_motion_rad >= cfg.stuck_motion_rad
+            {
+                return Err(Sensor::AlphaStuck);
+            }
+        } else {
+            last.same_alpha_count = 1;
+            last.implied_motion_rad = T::ZERO;
+        }
+        // Accepted: the run of identical readings goes on, or starts with this one.
+        last.tick = x.tick;
+        last.alpha_rad = x.alpha_rad;
+        last.alpha_rate_radps = x.alpha_rate_radps;
         Ok(())
     }
 }

@@ -17,7 +17,8 @@ with everything LLVM inlined into `Controller::step` sorted back into the paper'
 examples/trace_step.rs (one `Controller::step` a tick, built with the flight profile:
 `cargo build --profile firmware --target thumbv7em-none-eabihf --features firmware
 --example trace_step`), and the
-instructions counted are those from the N-th entry into `Controller::run` to the return to
+instructions counted are those from the N-th entry into `Controller::decide` (the step less its
+event bookkeeping, which is inlined into the caller with `Controller::run`) to the return to
 the caller. The trace is streamed through a pipe, not stored (a late step is some 4·10^7 lines in).
 
 Defaults: the flight firmware (target/thumbv7em-none-eabihf/firmware/tss-reel, build it with
@@ -76,7 +77,7 @@ def main():
         if a.elf == ap.get_default("elf"):
             a.elf = "target/thumbv7em-none-eabihf/firmware/examples/trace_step"
         pcs = mission_step_pcs(a.elf, a.mission_tick)
-        what = f"mission step {a.mission_tick}: {len(pcs)} instructions, Controller::run entry to return"
+        what = f"mission step {a.mission_tick}: {len(pcs)} instructions, Controller::decide entry to return"
     else:
         pcs = firmware_tick_pcs(a.elf, a.tick)
         what = f"tick {a.tick}: {len(pcs)} instructions, SysTick entry to SysTick entry"
@@ -105,14 +106,14 @@ def trace_pcs(lines):
 
 
 def mission_step_pcs(elf, n):
-    """The PCs of the n-th call of Controller::run (n counts from 0), read from a pipe:
+    """The PCs of the n-th call of Controller::decide (n counts from 0), read from a pipe:
     from its entry to the return to the caller (the instruction after the caller's `bl`)."""
     nm = subprocess.run(["llvm-nm", "--defined-only", elf], capture_output=True,
                         text=True, check=True).stdout
     entries = [int(l.split()[0], 16) & ~1 for l in nm.splitlines()
-               if "Controller" in l and "3run17h" in l]  # Controller::run, legacy mangling
+               if "Controller" in l and "6decide17h" in l]  # Controller::decide, legacy mangling
     if len(entries) != 1:
-        sys.exit(f"trace_profile: expected one Controller::run in {elf}, found {len(entries)}")
+        sys.exit(f"trace_profile: expected one Controller::decide in {elf}, found {len(entries)}")
     entry = entries[0]
     with tempfile.TemporaryDirectory() as tmp:
         fifo = os.path.join(tmp, "trace.fifo")

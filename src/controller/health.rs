@@ -43,8 +43,9 @@ impl HealthMachine {
     /// A usable sample that the law could use: Nominal, and the counter leaks by one.
     pub(super) fn usable(&mut self, flags: &mut Flags) {
         self.set(Health::Nominal, flags);
-        self.fault_level = self.fault_level.saturating_sub(1);
-        self.good_ticks = 0;
+        if self.fault_level > 0 {
+            self.fault_level -= 1;
+        }
     }
 
     /// No usable sample or law solution at this tick: Degraded, until the leaky counter
@@ -65,13 +66,14 @@ impl HealthMachine {
     }
 
     /// A valid sample in safe hold: `true` once `recovery_ticks` have arrived in a row, which
-    /// clears the counter (the law may run again; [`HealthMachine::usable`] then makes the
-    /// health Nominal).
+    /// clears the leaky counter and the run (the law may run again; [`HealthMachine::usable`]
+    /// then makes the health Nominal).
     pub(super) fn recovered<T>(&mut self, cfg: &MonitorConfig<T>) -> bool {
         self.good_ticks = self.good_ticks.saturating_add(1);
         let recovered = self.good_ticks >= cfg.recovery_ticks;
         if recovered {
             self.fault_level = 0;
+            self.good_ticks = 0;
         }
         recovered
     }
