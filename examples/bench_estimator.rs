@@ -39,7 +39,7 @@ mod bench {
     use core::hint::black_box;
     use nalgebra::{Matrix3, Vector3};
     use tss_reel::estimator::{Config, Drive, Estimator, Measurement};
-    pub use tss_reel::firmware::bench::{Meter, Stats, INSTRUCTIONS_PER_COUNT, K};
+    pub use tss_reel::firmware::bench::{Meter, Stats, K};
 
     /// Logs the distribution of one kind of step.
     pub fn report<const BINS: usize>(s: &Stats<BINS>, what: &str) {
@@ -176,24 +176,7 @@ mod bench {
 
 #[cortex_m_rt::entry]
 fn main() -> ! {
-    use bench::{Meter, INSTRUCTIONS_PER_COUNT, K};
-
-    let Some(core) = cortex_m::Peripherals::take() else {
-        defmt::error!("core peripherals already taken");
-        exit::failure();
-    };
-    let meter = Meter::start(core.SYST);
-    let delay = meter.instructions_of_delay(200_000);
-    defmt::info!(
-        "clock: {=u32} instructions per SysTick count (a 400000-instruction delay loop reads {=u32}), K = {=usize}",
-        INSTRUCTIONS_PER_COUNT,
-        delay,
-        K
-    );
-    if delay.abs_diff(400_000) > 400 {
-        defmt::error!("the clock is not 1 instruction per ns: run QEMU with -icount shift=0");
-        exit::failure();
-    }
+    let meter = tss_reel::firmware::bench::start_checked();
     bench::nalgebra_forms(&meter);
     bench::mission(&meter);
     defmt::info!("bench done");

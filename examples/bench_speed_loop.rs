@@ -36,7 +36,7 @@ use tss_reel::firmware::exit;
 
 mod bench {
     use core::hint::black_box;
-    pub use tss_reel::firmware::bench::{Meter, Stats, INSTRUCTIONS_PER_COUNT, K};
+    pub use tss_reel::firmware::bench::{Meter, Stats, K};
     use tss_reel::reel_drive::{Brake, DriveConfig, DriveInput, RateCommand, SpeedLoop};
 
     /// Issue 19's budget for one inner step, checked against the worst case.
@@ -252,28 +252,9 @@ mod bench {
 
 #[cortex_m_rt::entry]
 fn main() -> ! {
-    use bench::{Action, Meter, Tick, INSTRUCTIONS_PER_COUNT, K};
+    use bench::{Action, Tick};
 
-    let Some(core) = cortex_m::Peripherals::take() else {
-        defmt::error!("core peripherals already taken");
-        exit::failure();
-    };
-    let meter = Meter::start(core.SYST);
-    let delay = meter.instructions_of_delay(200_000);
-    defmt::info!(
-        "clock: {=u32} instructions per SysTick count (checked: a 400000-instruction delay loop reads {=u32}), K = {=usize} copies per measurement, loop overhead {=u32} instructions per {=usize} calls",
-        INSTRUCTIONS_PER_COUNT,
-        delay,
-        K,
-        meter.overhead(),
-        K
-    );
-    if delay.abs_diff(400_000) > 400 {
-        defmt::error!(
-            "the clock is not 1 instruction per ns: run QEMU with -icount shift=0 (see the example's docs)"
-        );
-        exit::failure();
-    }
+    let meter = tss_reel::firmware::bench::start_checked();
 
     let quiet = |action| Tick {
         action,

@@ -55,7 +55,7 @@ mod bench {
     use core::hint::black_box;
     use tss_reel::controller::{Config, Controller, Health, Input, Output, Phase};
     use tss_reel::equilibrium::ExistenceMonitor;
-    pub use tss_reel::firmware::bench::{Meter, Stats, INSTRUCTIONS_PER_COUNT, K};
+    pub use tss_reel::firmware::bench::{Meter, Stats, K};
     use tss_reel::law::{self, Blend, LawInput};
     use tss_reel::schedule::{PreparedBand, Reference};
 
@@ -433,30 +433,7 @@ mod bench {
 
 #[cortex_m_rt::entry]
 fn main() -> ! {
-    use bench::{Meter, INSTRUCTIONS_PER_COUNT, K};
-
-    let Some(core) = cortex_m::Peripherals::take() else {
-        defmt::error!("core peripherals already taken");
-        exit::failure();
-    };
-    let meter = Meter::start(core.SYST);
-    // 1 SysTick count must be 40 instructions (icount shift=0, 25 MHz SysTick): a delay loop
-    // of 400 000 instructions must read 400 000 ± a few counts' worth.
-    let delay = meter.instructions_of_delay(200_000);
-    defmt::info!(
-        "clock: {=u32} instructions per SysTick count (checked: a 400000-instruction delay loop reads {=u32}), K = {=usize} copies per measurement, loop overhead {=u32} instructions per {=usize} calls",
-        INSTRUCTIONS_PER_COUNT,
-        delay,
-        K,
-        meter.overhead(),
-        K
-    );
-    if delay.abs_diff(400_000) > 400 {
-        defmt::error!(
-            "the clock is not 1 instruction per ns: run QEMU with -icount shift=0 (scripts/bench-target)"
-        );
-        exit::failure();
-    }
+    let meter = tss_reel::firmware::bench::start_checked();
     bench::primitives(&meter);
 
     bench::measure(

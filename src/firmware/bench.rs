@@ -177,3 +177,31 @@ impl<const BINS: usize> Default for Stats<BINS> {
         Self::new()
     }
 }
+
+/// Takes the core peripherals, starts the [`Meter`] and checks the clock: a delay loop of
+/// 400 000 instructions must read 400 000 (± 400), else QEMU is not counting one instruction
+/// per ns (`-icount shift=0`, as `scripts/bench-target` runs it) and the run ends with a
+/// failing exit. Logs the clock line every benchmark starts with.
+pub fn start_checked() -> Meter {
+    let Some(core) = cortex_m::Peripherals::take() else {
+        defmt::error!("core peripherals already taken");
+        super::exit::failure();
+    };
+    let meter = Meter::start(core.SYST);
+    let delay = meter.instructions_of_delay(200_000);
+    defmt::info!(
+        "clock: {=u32} instructions per SysTick count (checked: a 400000-instruction delay loop reads {=u32}), K = {=usize} copies per measurement, loop overhead {=u32} instructions per {=usize} calls",
+        INSTRUCTIONS_PER_COUNT,
+        delay,
+        K,
+        meter.overhead(),
+        K
+    );
+    if delay.abs_diff(400_000) > 400 {
+        defmt::error!(
+            "the clock is not 1 instruction per ns: run QEMU with -icount shift=0 (scripts/bench-target)"
+        );
+        super::exit::failure();
+    }
+    meter
+}
