@@ -281,27 +281,34 @@ pub fn history_header() -> String {
 pub fn write_history_csv<W: Write>(mut w: W, samples: &[Sample]) -> io::Result<()> {
     writeln!(w, "{}", history_header())?;
     for s in samples {
-        writeln!(
-            w,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            s.t_s,
-            s.length_m,
-            s.length_rate_mps,
-            s.alpha_rad,
-            s.alpha_ref_rad,
-            s.delta_rad,
-            s.delta_rate_radps,
-            s.beta_rad,
-            s.tension_n,
-            s.phase.as_str(),
-            s.alpha_rate_radps,
-            s.length_accel_mps2,
-            s.law_rate_mps,
-            s.blend_weight,
-            s.flags,
-        )?;
+        write_sample(&mut w, s)?;
+        writeln!(w)?;
     }
     w.flush()
+}
+
+/// One sample's [`HISTORY_COLUMNS`] and [`HISTORY_EXTRA_COLUMNS`], comma-separated, without
+/// the line end (the elastic history appends its own columns).
+fn write_sample<W: Write>(w: &mut W, s: &Sample) -> io::Result<()> {
+    write!(
+        w,
+        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+        s.t_s,
+        s.length_m,
+        s.length_rate_mps,
+        s.alpha_rad,
+        s.alpha_ref_rad,
+        s.delta_rad,
+        s.delta_rate_radps,
+        s.beta_rad,
+        s.tension_n,
+        s.phase.as_str(),
+        s.alpha_rate_radps,
+        s.length_accel_mps2,
+        s.law_rate_mps,
+        s.blend_weight,
+        s.flags,
+    )
 }
 
 /// The columns the elastic plant's `history.csv` adds after [`HISTORY_EXTRA_COLUMNS`]
@@ -329,30 +336,11 @@ pub fn write_elastic_history_csv<W: Write>(
         HISTORY_ELASTIC_COLUMNS.join(",")
     )?;
     for (s, e) in samples.iter().zip(elastic) {
+        write_sample(&mut w, s)?;
         writeln!(
             w,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            s.t_s,
-            s.length_m,
-            s.length_rate_mps,
-            s.alpha_rad,
-            s.alpha_ref_rad,
-            s.delta_rad,
-            s.delta_rate_radps,
-            s.beta_rad,
-            s.tension_n,
-            s.phase.as_str(),
-            s.alpha_rate_radps,
-            s.length_accel_mps2,
-            s.law_rate_mps,
-            s.blend_weight,
-            s.flags,
-            e.range_m,
-            e.tension_tip_n,
-            e.bowing_m,
-            e.alpha_sensed_rad,
-            e.reel_rate_mps,
-            e.beads,
+            ",{},{},{},{},{},{}",
+            e.range_m, e.tension_tip_n, e.bowing_m, e.alpha_sensed_rad, e.reel_rate_mps, e.beads,
         )?;
     }
     w.flush()
