@@ -4,6 +4,7 @@
 //! by [`crate::controller::Controller::new`]): a controller that exists is a valid one. Errors
 //! are typed and name the parameter (its path in [`Config`]) and the value.
 
+use crate::controller::ProtectionConfig;
 use crate::envelope::Envelope;
 use crate::law::Gains;
 use crate::mass::MassModel;
@@ -154,6 +155,9 @@ pub struct Config<T> {
     pub envelope: Envelope<T>,
     /// Sensor checks and fault timing.
     pub monitor: MonitorConfig<T>,
+    /// Tension- and drive-aware protection (docs/equations.md §13); `None`: the paper's
+    /// controller, bounded by the envelope alone.
+    pub protection: Option<ProtectionConfig<T>>,
 }
 
 impl<T: Real> Config<T> {
@@ -191,6 +195,7 @@ impl<T: Real> Config<T> {
                 max_length_m: T::from_f64(40_000.0),
             },
             monitor: MonitorConfig::default_for_period(),
+            protection: None,
         }
     }
 
@@ -254,6 +259,9 @@ impl<T: Real> Config<T> {
         positive("keep_capture_m", self.keep_capture_m)?;
         let env = &self.envelope;
         self.monitor.validate()?;
+        if let Some(p) = &self.protection {
+            p.validate(self.period_s)?;
+        }
         positive("envelope.max_rate_mps", env.max_rate_mps)?;
         positive("envelope.max_accel_mps2", env.max_accel_mps2)?;
         positive("envelope.min_length_m", env.min_length_m)?;

@@ -770,6 +770,7 @@ pub fn config_digest(cfg: &crate::controller::Config<f32>) -> u32 {
         keep_capture_m,
         envelope,
         monitor,
+        protection,
     } = cfg;
     let Orbit {
         semi_major_axis_m,
@@ -877,6 +878,19 @@ pub fn config_digest(cfg: &crate::controller::Config<f32>) -> u32 {
         good_samples_per_bad,
     ] {
         h = fnv1a(h, &n.to_le_bytes());
+    }
+    // The protection, when configured (an unprotected configuration's digest is unchanged).
+    if let Some(p) = protection {
+        let crate::controller::ProtectionConfig {
+            min_tension_n,
+            max_tension_n,
+            tension_filter_s,
+            drive_lag_s,
+        } = p;
+        h = fnv1a(h, &[1]);
+        for x in [min_tension_n, max_tension_n, tension_filter_s, drive_lag_s] {
+            h = fnv1a_f32(h, *x);
+        }
     }
     h
 }

@@ -31,6 +31,9 @@ pub enum EventKind {
     BlendRestart,
     /// This phase stopped getting closer to its keep length ([`super::Flags::NO_PROGRESS`]).
     NoProgress(Phase),
+    /// The protection's tension bound began to restrict the command
+    /// ([`super::Flags::TENSION_LIMITED`], set at this step and not at the one before).
+    TensionLimited,
 }
 
 /// An event and the tick it happened at.

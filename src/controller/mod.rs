@@ -38,6 +38,7 @@ mod clock;
 mod events;
 mod health;
 mod output;
+pub(crate) mod protection;
 mod sequencer;
 
 use crate::envelope::PreparedEnvelope;
@@ -51,10 +52,12 @@ pub use crate::envelope::Envelope;
 pub use crate::monitor::{Input, Sensor};
 pub use events::{Event, EventKind, EVENT_CAPACITY};
 pub use output::{Fault, Flags, Health, Output, Phase};
+pub use protection::{ProtectionConfig, MAX_PLAUSIBLE_TENSION_N};
 
 use clock::{Clock, Elapsed};
 use events::EventRing;
 use health::{DeadReckoning, HealthMachine};
+use protection::{Bounds, FreeTensionModel, Protection};
 use sequencer::{Progress, Sequencer};
 
 pub use sequencer::PROGRESS_TIME_CONSTANTS;
@@ -68,6 +71,8 @@ pub struct Controller<T: Real> {
     cfg: Config<T>,
     /// The envelope, its guarded length limits worked out.
     envelope: PreparedEnvelope<T>,
+    /// The tension- and drive-aware protection (None: not configured).
+    protection: Option<Protection<T>>,
     existence: ExistenceMonitor<T>,
     monitor: Monitor<T>,
     sequencer: Sequencer<T>,
@@ -103,6 +108,16 @@ impl<T: Real> Controller<T> {
         let spool_m = T::from_f64(cfg.envelope.max_length_m.to_f64() * (1.0 + SPOOL_MARGIN));
         Ok(Self {
             envelope: PreparedEnvelope::new(cfg.envelope),
+            protection: cfg.protection.map(|p| {
+                let env = &cfg.envelope;
+                Protection::new(
+                    p,
+                    cfg.masses,
+                    cfg.period_s,
+                    env.max_rate_mps,
+                    cfg.initial_rate_mps,
+                )
+            }),
             existence,
             monitor: Monitor::new(spool_m)?,
             sequencer: Sequencer::new(&cfg),
@@ -192,8 +207,9 @@ impl<T: Real> Controller<T> {
     /// A step, then its events and the kept output.
     fn run(&mut self, tick: u32, sample: Option<&Input<T>>) -> Output<T> {
         let (health, phase) = (self.health.health(), self.sequencer.phase());
+        let tension_limited = self.out.flags.contains(Flags::TENSION_LIMITED);
         self.decide(tick, sample);
-        self.record_events(health, phase);
+        self.record_events(health, phase, tension_limited);
         self.out
     }
 
@@ -217,6 +233,15 @@ impl<T: Real> Controller<T> {
             Err(s) => return self.reject_stale(tick, Fault::Sensor(s), flags),
         };
         let elapsed_s = T::from_u32(elapsed_ticks) * dt;
+        if let Some(p) = &mut self.protection {
+            p.advance(
+                self.last_rate_cmd_mps,
+                self.out.accel_cmd_mps2,
+                elapsed_ticks,
+                None,
+                None,
+            );
+        }
         // Dead reckoning: the reel ran at the last command since the last step.
         let predicted_m = self.length.predict(self.last_rate_cmd_mps, elapsed_s);
 
@@ -280,24 +305,18 @@ impl<T: Real> Controller<T> {
         // The envelope. The acceleration limit holds per command: a command differs from the
         // previous one by at most a·Δt, whatever the calls' pattern (a gap of n ticks does
         // not allow n·a·Δt: the reel ran at the previous command all along, and would step).
+        // The protection bounds it further by the tension the tether carries (and the drive).
         let previous = self.last_rate_cmd_mps;
-        let (rate, sat) = self
-            .envelope
-            .limit_request(law.rate_mps, previous, x.length_m, dt);
+        let bounds = self.bounds(Some(&FreeTensionModel::of(&law_in, &law)), previous);
+        let (rate, sat) =
+            self.envelope
+                .limit_request(law.rate_mps, previous, x.length_m, dt, &bounds);
         flags.set(sat.0);
         flags.set_if(reference.slewing, Flags::SLEWING);
-        // A limited command's acceleration is its change over the period. Otherwise Eq. 30's,
-        // bounded like every commanded quantity: Eq. 30 is the law's derivative, which leaves
-        // the envelope where the law's rate jumps (a blend restart from a held rate).
-        let max_accel = self.cfg.envelope.max_accel_mps2;
-        let accel = if sat.any() {
-            (rate - previous) / dt
-        } else if accel_mps2.abs() > max_accel {
-            flags.set(Flags::ACCEL_SATURATED);
-            accel_mps2.clamp_finite(-max_accel, max_accel)
-        } else {
-            accel_mps2
-        };
+        let (accel, accel_sat) = self
+            .envelope
+            .commanded_accel(accel_mps2, rate, previous, dt, sat, &bounds);
+        flags.set(accel_sat.0);
         self.last_rate_cmd_mps = rate;
         match self
             .sequencer
@@ -400,8 +419,11 @@ impl<T: Real> Controller<T> {
             }
         };
         let length_m = self.length.length_m().unwrap_or(T::ZERO);
-        let (rate, sat) = self.envelope.limit_request(target, previous, length_m, dt);
-        flags.set(sat.0 & Flags::LENGTH_LIMITED);
+        let bounds = self.bounds(None, previous);
+        let (rate, sat) = self
+            .envelope
+            .limit_request(target, previous, length_m, dt, &bounds);
+        flags.set(sat.0 & (Flags::LENGTH_LIMITED | Flags::TENSION_LIMITED));
         self.last_rate_cmd_mps = rate;
         let mu3 = self.cfg.masses.mu3_and_slope(length_m).0;
         let x_rate = self.existence.normalised_rate(mu3, length_m, rate);
@@ -426,6 +448,16 @@ impl<T: Real> Controller<T> {
         };
     }
 
+    /// The protection's bounds of this step (none without a protection), `model` the law's
+    /// state when it ran.
+    fn bounds(&mut self, model: Option<&FreeTensionModel<T>>, previous_mps: T) -> Bounds<T> {
+        let dt = self.cfg.period_s;
+        match &mut self.protection {
+            Some(p) => p.bounds(model, previous_mps, dt),
+            None => Bounds::none(),
+        }
+    }
+
     /// The Eq. 13 whole-orbit margin of a command whose normalised rate (Eq. 7) is `x`:
     /// min Depl − |x| (> 0 inside the region). Near docking x grows as 1/l, so the margin is
     /// reported no lower than −[`MAX_REPORTED_MARGIN`] (it is never above min Depl); a zero
@@ -447,7 +479,7 @@ impl<T: Real> Controller<T> {
     // before it still in registers): 8 instructions less on the mission's worst step
     // (scripts/bench-target: 558 → 550).
     #[inline(always)]
-    fn record_events(&mut self, health: Health, phase: Phase) {
+    fn record_events(&mut self, health: Health, phase: Phase, tension_limited: bool) {
         let out = &self.out;
         let tick = out.tick;
         if out.health != health {
@@ -470,6 +502,10 @@ impl<T: Real> Controller<T> {
         self.last_fault = out.fault;
         if out.flags.contains(Flags::BLEND_RESTART) {
             let kind = EventKind::BlendRestart;
+            self.events.push(Event { tick, kind });
+        }
+        if out.flags.contains(Flags::TENSION_LIMITED) && !tension_limited {
+            let kind = EventKind::TensionLimited;
             self.events.push(Event { tick, kind });
         }
     }

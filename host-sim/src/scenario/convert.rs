@@ -70,6 +70,7 @@ impl Scenario {
             keep_capture_m: f(sc.controller.keep_capture_m),
             envelope: sc.envelope.to_envelope(),
             monitor: sc.monitor.to_monitor_config(),
+            protection: sc.protection.to_protection_config(),
         }
     }
 
