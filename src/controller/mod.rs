@@ -52,7 +52,7 @@ pub use crate::envelope::Envelope;
 pub use crate::monitor::{Input, Sensor};
 pub use events::{Event, EventKind, EVENT_CAPACITY};
 pub use output::{Fault, Flags, Health, Output, Phase};
-pub use protection::{ProtectionConfig, MAX_PLAUSIBLE_TENSION_N};
+pub use protection::{ProtectionConfig, MARGIN_OF_GRAVITY_GRADIENT, MAX_PLAUSIBLE_TENSION_N};
 
 use clock::{Clock, Elapsed};
 use events::EventRing;

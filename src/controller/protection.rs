@@ -26,12 +26,21 @@
 //!
 //! The bound acts on the acceleration, so its words differ from the issue's ("below a minimum
 //! tension, pay-out slows and wind-in stops"): below T_min it *slows a pay-out* (l̈ < 0 raises
-//! T) and *slows the braking of a wind-in* (braking a wind-in, l̈ > 0, lowers T at once: the
-//! O-4 slack); it never reverses the reel or speeds it away from rest for the sake of tension
-//! (the command it allows is never below min(u_prev, 0)), so a reel at rest with too little
-//! tension stays at rest. Above T_max the reverse: it slows a wind-in and does not brake a
-//! pay-out (never above max(u_prev, 0)). The envelope's acceleration limit wins over it, and
-//! the length limits win over both.
+//! T at once) and *does not brake a wind-in* (braking a wind-in, l̈ > 0, lowers T at once: the
+//! O-4 slack); if the deficit persists it speeds a wind-in up, which raises T as long as the
+//! tether is taut, the only state the rigid Eq. 5a describes and the one the bound keeps.
+//! Stopping a wind-in is the lever of a *slack* flexible tether (do not reel in slack line);
+//! a taut one is kept taut by the opposite. Above T_max the reverse: a wind-in slows, a pay-out
+//! is not braked. The envelope's acceleration limit wins over the bound, and the length limits
+//! win over both.
+//!
+//! The margin T_min cannot exceed the free tension the reel has to work with: at rest the
+//! tension *is* the free tension, and a bound above it winds the tether in for as long as it
+//! lasts (a fixed 2 mN at l ≈ 5 m wound the tether in against the law for 1 600 s). On a short
+//! tether the margin is therefore a quarter of the vertical tether's gravity-gradient tension,
+//! [`MARGIN_OF_GRAVITY_GRADIENT`] × 3 m_r n² l: half the free tension of the deployment's
+//! reference state (α_r = −45°: 1.5 m_r n² l), so the bound never holds the law's reference
+//! back. Past l ≈ 24 m (paper masses) T_min itself applies.
 //!
 //! **The drive.** A drive with a first-order lag τ runs at v with dv/dt = (u − v)/τ. Under a
 //! command held for a period (h = Δt/τ): v_end = u + (v₀ − u)e^{−h}, its acceleration at the
@@ -226,7 +235,17 @@ pub(crate) struct Protection<T> {
     /// The model's free tension at the last law step, N (for the steps on which the law did
     /// not run: coast and safe hold).
     last_model_n: Option<T>,
+    /// The least tension kept at the last law step, N: T_min, or less on a short tether
+    /// ([`MARGIN_OF_GRAVITY_GRADIENT`]).
+    min_tension_n: T,
 }
+
+/// On a short tether the least tension kept is at most this share of the vertical tether's
+/// gravity-gradient tension 3 m_r n² l: half of what the deployment's reference state (α_r =
+/// −45°, free tension 1.5 m_r n² l) has, so that the bound never holds the reel against the law
+/// at the reference (a fixed T_min above 1.5 m_r n² l winds a short tether in for ever:
+/// docs/equations.md §13).
+pub const MARGIN_OF_GRAVITY_GRADIENT: f64 = 0.25;
 
 impl<T: Real> Protection<T> {
     /// The protection of a validated configuration, the drive running at `initial_rate_mps`.
@@ -267,6 +286,7 @@ impl<T: Real> Protection<T> {
             tension_sample_n: None,
             ticks_without_tension: 0,
             last_model_n: None,
+            min_tension_n: cfg.min_tension_n,
         }
     }
 
@@ -333,12 +353,15 @@ impl<T: Real> Protection<T> {
         };
         if let Some(m) = model {
             self.last_model_n = Some(self.model_free_tension_n(m));
+            let n2l = m.orbit_rate_radps * m.orbit_rate_radps * m.length_m;
+            let short = T::from_f64(3.0 * MARGIN_OF_GRAVITY_GRADIENT) * self.radial_kg * n2l;
+            self.min_tension_n = self.cfg.min_tension_n.min(short);
         }
         let tension_n = self.tension_sample_n.take();
-        let Some(free_n) = self.free_tension_n(tension_n) else {
+        let Some(free_n) = self.free_tension_n(tension_n, model.is_some()) else {
             return b;
         };
-        let a_hi = (free_n - self.cfg.min_tension_n) * self.inv_radial_per_kg;
+        let a_hi = (free_n - self.min_tension_n) * self.inv_radial_per_kg;
         let a_lo = (free_n - self.cfg.max_tension_n) * self.inv_radial_per_kg;
         // The change of command that keeps the drive's acceleration in [a_lo, a_hi].
         let (du_lo, du_hi) = match self.lag {
@@ -348,9 +371,7 @@ impl<T: Real> Protection<T> {
             }
             None => (a_lo * dt_s, a_hi * dt_s),
         };
-        // Never reverse the reel, or drive it away from rest, for the tension's sake.
-        let hi = (previous_mps + du_hi).max(previous_mps.min(T::ZERO));
-        let lo = (previous_mps + du_lo).min(previous_mps.max(T::ZERO));
+        let (lo, hi) = (previous_mps + du_lo, previous_mps + du_hi);
         b.tension_rate_mps = Some((lo, hi));
         b.tension_accel_mps2 = Some((a_lo, a_hi));
         b
@@ -377,8 +398,9 @@ impl<T: Real> Protection<T> {
     }
 
     /// The free-tension estimate of this step: the model corrected by the load cell's mean
-    /// residual, if the load cell gave a plausible sample now (N).
-    fn free_tension_n(&mut self, tension_n: Option<T>) -> Option<T> {
+    /// residual, if the load cell gave a plausible sample now (N). With a stale model (the law
+    /// did not run: coast, safe hold) the correction is used as it stands, not updated.
+    fn free_tension_n(&mut self, tension_n: Option<T>, fresh_model: bool) -> Option<T> {
         let model_n = self.last_model_n?;
         let plausible = T::from_f64(MAX_PLAUSIBLE_TENSION_N);
         let Some(t) = tension_n.filter(|t| t.is_finite() && t.abs() <= plausible) else {
@@ -389,6 +411,9 @@ impl<T: Real> Protection<T> {
             return None;
         };
         self.ticks_without_tension = 0;
+        if !fresh_model {
+            return self.correction.map(|c| model_n + c.residual_n);
+        }
         // The tension at zero drive acceleration, as measured.
         let residual = t + self.radial_kg * self.drive_accel_mps2 - model_n;
         let c = match self.correction {
@@ -497,46 +522,67 @@ mod tests {
             .is_none());
     }
 
+    /// Below T_min the bound lowers the command by the tension deficit over m_r per period
+    /// (l̈ < 0 raises T, Eq. 5a), whatever the direction: a pay-out slows, a wind-in is not
+    /// braked but sped up; above T_max the reverse.
     #[test]
-    fn low_tension_slows_a_pay_out_but_never_reverses_it() {
-        let mut p = protection(0.0);
-        let model = vertical(10.0); // 3.3 mN free
-                                    // The load cell says 1 N less than the model: far below T_min.
-        let t = p.model_free_tension_n(&model) - 1.0;
-        let (lo, hi) = p
-            .sample(t)
-            .bounds(Some(&model), 0.005, 1.0)
-            .tension_rate_mps
-            .unwrap();
-        assert_eq!(hi, 0.0, "the pay-out slows to rest, no further");
-        assert!(lo <= hi);
-        // A wind-in is held at its rate: neither braked (that lowers T) nor sped up.
-        let (_, hi) = p
-            .sample(t)
-            .bounds(Some(&model), -0.5, 1.0)
-            .tension_rate_mps
-            .unwrap();
-        assert_eq!(hi, -0.5);
-    }
-
-    #[test]
-    fn high_tension_slows_a_wind_in_but_never_reverses_it() {
+    fn the_bound_acts_on_the_acceleration_in_either_direction() {
         let mut p = protection(0.0);
         let model = vertical(1000.0);
-        let t = p.model_free_tension_n(&model) + 100.0;
-        let (lo, hi) = p
-            .sample(t)
-            .bounds(Some(&model), -0.005, 1.0)
-            .tension_rate_mps
-            .unwrap();
-        assert_eq!(lo, 0.0);
-        assert!(hi >= lo);
-        let (lo, _) = p
-            .sample(t)
-            .bounds(Some(&model), 0.5, 1.0)
-            .tension_rate_mps
-            .unwrap();
-        assert_eq!(lo, 0.5);
+        let free = p.model_free_tension_n(&model);
+        let m_r = p.radial_kg;
+        for previous in [0.5, 0.0, -0.5] {
+            // 1 N below T_min: the command must fall by (1 N)/m_r within the period.
+            let t = 2e-3 - 1.0;
+            let (_, hi) = p
+                .sample(t)
+                .bounds(Some(&model), previous, 1.0)
+                .tension_rate_mps
+                .unwrap();
+            assert!(
+                (hi - (previous - 1.0 / m_r)).abs() < 1e-9,
+                "{previous}: {hi}"
+            );
+            // 1 N above T_max: it must rise by (1 N)/m_r.
+            let mut q = protection(0.0);
+            let t = 51.0;
+            let (lo, _) = q
+                .sample(t)
+                .bounds(Some(&model), previous, 1.0)
+                .tension_rate_mps
+                .unwrap();
+            assert!(
+                (lo - (previous + 1.0 / m_r)).abs() < 1e-9,
+                "{previous}: {lo}"
+            );
+        }
+        // (The model agreed with nothing here: the load cell's first sample sets the estimate.)
+        assert!(free > 0.3);
+    }
+
+    /// On a short tether the margin is a quarter of 3 m_r n² l, so the reference state of the
+    /// deployment (free tension 1.5 m_r n² l at α = −45°) is never held against the law.
+    #[test]
+    fn a_short_tether_keeps_a_quarter_of_its_gravity_gradient_tension() {
+        let mut p = protection(0.0);
+        let m_r = p.radial_kg;
+        let at_45 = FreeTensionModel {
+            length_m: 5.0,
+            orbit_rate_radps: N,
+            alpha_rate_radps: 0.0,
+            cos_two_alpha: 0.0,
+        };
+        let free = p.model_free_tension_n(&at_45);
+        assert!((free - 1.5 * m_r * N * N * 5.0).abs() < 1e-15);
+        let b = p.sample(free).bounds(Some(&at_45), 0.0, 1.0);
+        let margin = 0.75 * m_r * N * N * 5.0;
+        assert!((p.min_tension_n - margin).abs() < 1e-15);
+        // At rest the reference state may pay out (a_hi > 0): nothing holds it back.
+        let (_, a_hi) = b.tension_accel_mps2.unwrap();
+        assert!((a_hi - (free - margin) / m_r).abs() < 1e-15 && a_hi > 0.0);
+        // A long tether keeps T_min.
+        let _ = p.sample(1.0).bounds(Some(&vertical(10_000.0)), 0.0, 1.0);
+        assert_eq!(p.min_tension_n, 2e-3);
     }
 
     /// A lagging drive's peak acceleration, at the start of each period, is what the bound
