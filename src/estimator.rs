@@ -527,7 +527,19 @@ impl<T: Real> Estimator<T> {
     /// One control period: carries the estimate over the period that just ended under
     /// `drive`, then updates it with this period's α sample (`None`: a dropout).
     pub fn step(&mut self, drive: &Drive<T>, alpha_rad: Option<T>) -> Output<T> {
-        let prediction = match self.track {
+        let prediction = self.predict_period(drive);
+        let measurement = self.update_with(alpha_rad);
+        Output {
+            estimate: self.estimate(),
+            prediction,
+            measurement,
+        }
+    }
+
+    /// The first half of [`Estimator::step`]: carries the estimate over one period under
+    /// `drive` (a caller whose calls skipped periods carries it over each, then updates once).
+    pub fn predict_period(&mut self, drive: &Drive<T>) -> Prediction {
+        match self.track {
             None => Prediction::NoEstimate,
             Some(track) => match self.predict(&track, drive) {
                 Ok(next) => {
@@ -539,13 +551,19 @@ impl<T: Real> Estimator<T> {
                     p
                 }
             },
-        };
-        let measurement = self.update(alpha_rad);
-        Output {
-            estimate: self.estimate(),
-            prediction,
-            measurement,
         }
+    }
+
+    /// The second half of [`Estimator::step`]: the update with this period's α sample
+    /// (`None`: a dropout, nothing to do).
+    pub fn update_with(&mut self, alpha_rad: Option<T>) -> Measurement<T> {
+        self.update(alpha_rad)
+    }
+
+    /// Drops the estimate: the next sample starts afresh (a caller that cannot say what
+    /// drove the libration over a period).
+    pub fn reset(&mut self) {
+        self.track = None;
     }
 
     /// A fresh track at α with α̇ and d given, and the start's variances.

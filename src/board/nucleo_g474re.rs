@@ -260,7 +260,7 @@ mod board {
     /// The outer loop's state.
     struct Outer {
         controller: Controller<f32>,
-        devices: Devices<Replay, Replay, Replay, CommandLatch>,
+        devices: Devices<Replay, Replay, Replay, CommandLatch, Replay>,
     }
 
     impl Outer {
@@ -361,7 +361,7 @@ mod board {
             }));
         });
 
-        let controller = match Controller::new(Config::paper()) {
+        let controller = match Controller::new(Config::flight()) {
             Ok(c) => c,
             Err(e) => defmt::panic!("controller configuration rejected: {}", e),
         };
@@ -372,6 +372,7 @@ mod board {
                 swing: Replay,
                 orbit: Replay,
                 reel: CommandLatch { latest: None },
+                tension: Replay,
             },
         };
 
