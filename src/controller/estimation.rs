@@ -73,8 +73,6 @@ pub(super) struct Estimation<T: Real> {
     orbit: Option<OrbitTerms<T>>,
     /// What the last step commanded (`None` before the first step).
     commanded: Option<Commanded<T>>,
-    /// The estimate after the last step.
-    estimate: Option<Estimate<T>>,
     /// The NIS of the last step's α sample, if one met the estimate.
     nis: Option<T>,
     /// The estimate was found useless, and no α has been used since: it stays useless (its α
@@ -95,15 +93,20 @@ impl<T: Real> Estimation<T> {
             max_alpha_var_rad2,
             orbit: None,
             commanded: None,
-            estimate: None,
             nis: None,
             useless: false,
         })
     }
 
     /// The estimate after the last step.
-    pub(super) fn estimate(&self) -> Option<&Estimate<T>> {
-        self.estimate.as_ref()
+    pub(super) fn estimate(&self) -> Option<Estimate<T>> {
+        self.filter.estimate()
+    }
+
+    /// The law computed sin 2α and cos 2α for `alpha_rad` (the estimate's α̂): the next
+    /// prediction reuses them.
+    pub(super) fn lend_sin_cos_two_alpha(&mut self, alpha_rad: T, sin: T, cos: T) {
+        self.filter.lend_sin_cos_two_alpha(alpha_rad, sin, cos);
     }
 
     /// The NIS of the last step's α sample, if one met the estimate.
@@ -145,7 +148,7 @@ impl<T: Real> Estimation<T> {
             gap_lost || last_lost
         };
         let m = self.filter.update_with(alpha_rad);
-        self.estimate = self.filter.estimate();
+        let estimate = self.filter.estimate();
         let (nis, event) = match m {
             Measurement::Accepted(i) | Measurement::Gated(i) => (Some(i.nis), None),
             Measurement::Reinitialised(i) => (Some(i.nis), Some(EventKind::EstimateRestarted)),
@@ -163,7 +166,7 @@ impl<T: Real> Estimation<T> {
         ) {
             self.useless = false;
         }
-        let verdict = match (m, &self.estimate) {
+        let verdict = match (m, &estimate) {
             (Measurement::Gated(_), _) => Estimated::Unusable(Sensor::AlphaGated),
             (_, Some(e)) if !self.useless && e.alpha_var_rad2 <= self.max_alpha_var_rad2 => {
                 Estimated::Usable(e.alpha_rad, e.alpha_rate_radps)
