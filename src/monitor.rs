@@ -474,4 +474,34 @@ mod tests {
             assert_eq!(m.check(&cfg, &x, None, 1.0).map(drop), Ok(()), "{x:?}");
         }
     }
+
+    #[test]
+    fn on_the_estimator_alpha_is_optional_its_rate_ignored_and_jumps_left_to_the_gate() {
+        let cfg = MonitorConfig::<f64>::default_for_period();
+        let mut m = Monitor::new(42_000.0, false).unwrap();
+        let x = |tick, alpha_rad: Option<f64>, rate: Option<f64>| Input {
+            alpha_rad,
+            alpha_rate_radps: rate,
+            ..sample(tick, 0.0, 0.0)
+        };
+        assert_eq!(
+            m.check(&cfg, &x(0, Some(0.5), None), None, 1.0),
+            Ok(Swing::Angle(Some(0.5)))
+        );
+        // No α: accepted, for the estimator to predict; α̇, even absurd, is not looked at.
+        assert_eq!(
+            m.check(&cfg, &x(1, None, Some(f64::NAN)), None, 1.0),
+            Ok(Swing::Angle(None))
+        );
+        // A jump far beyond alpha_jump_rad: the estimator's gate judges it, not the monitor.
+        assert_eq!(
+            m.check(&cfg, &x(2, Some(-2.0), Some(5.0)), None, 1.0),
+            Ok(Swing::Angle(Some(-2.0)))
+        );
+        // The range check stays.
+        assert_eq!(
+            m.check(&cfg, &x(3, Some(f64::INFINITY), None), None, 1.0),
+            Err(Sensor::Alpha)
+        );
+    }
 }

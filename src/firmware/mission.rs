@@ -7,8 +7,9 @@
 //! recovers). The replay ([`tss_reel::recordings::sensors::Replay`], shared with the
 //! NUCLEO-G474RE firmware) implements the [`tss_reel::hal`] sensor traits; the reel drive is a
 //! telemetry sink that folds every command into a digest. The controller is the flight one:
-//! `tss_reel::controller::Controller<f32>` with the paper's configuration, stepped once per
-//! SysTick through [`tss_reel::hal::control_cycle`].
+//! `tss_reel::controller::Controller<f32>` with the flight configuration
+//! (`Config::flight`: the paper's mission on the onboard estimator, from the recorded α alone
+//! and the encoder's rate), stepped once per SysTick through [`tss_reel::hal::control_cycle`].
 //!
 //! The contract with the main loop in `main.rs`:
 //! - [`CONTROL_PERIOD_MS`]: the control period; one SysTick interrupt per period;
