@@ -249,3 +249,52 @@ impl<T: Real> Estimation<T> {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_drive_takes_the_orbit_terms_from_theta_on_an_eccentric_orbit_only() {
+        let cfg = estimator::Config::<f64>::paper();
+        let circular = Estimation::new(&cfg, &Orbit::circular(7_078_000.0)).unwrap();
+        let n = 1.06e-3;
+        let t = circular.orbit_terms(n, 2.0);
+        assert_eq!((t.accel_radps2, t.gravity_gradient_per_s2), (0.0, n * n));
+        let orbit = Orbit::elliptic(7_078_000.0, 0.1);
+        let eccentric = Estimation::new(&cfg, &orbit).unwrap();
+        let theta = 2.0;
+        let t = eccentric.orbit_terms(n, theta);
+        assert_eq!(t.rate_radps, n);
+        assert_eq!(t.accel_radps2, orbit.true_anomaly_accel_radps2(theta));
+        assert_eq!(
+            t.gravity_gradient_per_s2,
+            orbit.gravity_gradient_per_s2(theta)
+        );
+        assert!(t.accel_radps2 != 0.0);
+    }
+
+    #[test]
+    fn the_drive_is_the_last_command_or_the_measured_mean_rate() {
+        let cfg = estimator::Config::<f64>::paper();
+        let mut e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0)).unwrap();
+        assert_eq!(e.drive(0, None), None);
+        e.orbit = Some(e.orbit_terms(1.06e-3, 0.0));
+        e.commanded(Commanded {
+            length_m: 100.0,
+            rate_mps: 2.0,
+            accel_mps2: 0.1,
+            mu3: 0.01,
+        });
+        let d = e.drive(0, None).unwrap();
+        assert_eq!(
+            (d.length_m, d.rate_mps, d.accel_mps2, d.mu3),
+            (100.0, 2.0, 0.1, 0.01)
+        );
+        // The encoder's mean rate over the period is the drive's rate at mid-period.
+        let d = e.drive(0, Some(2.2)).unwrap();
+        assert_eq!(d.rate_mps + 0.5 * d.accel_mps2 * 1.0, 2.2);
+        // The k-th period of a gap starts k periods of the command further on.
+        assert_eq!(e.drive(3, None).unwrap().length_m, 106.0);
+    }
+}
