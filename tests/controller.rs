@@ -736,7 +736,7 @@ fn a_gap_in_the_calls_longer_than_the_estimator_carries_drops_the_estimate() {
         alpha_rate_radps: None,
         ..sample(tick, 100.0)
     };
-    let mut lost = |ctl: &mut Controller<f32>| {
+    let lost = |ctl: &mut Controller<f32>| {
         let mut at = None;
         while let Some(e) = ctl.pop_event() {
             if e.kind == EventKind::EstimateLost {
