@@ -281,6 +281,9 @@ impl<T: Real> Protection<T> {
     /// acceleration was `accel_cmd_mps2`) for `elapsed_ticks` periods; `measured_rate_mps` is
     /// the encoder's mean rate over the last period and `tension_n` the load cell's sample, if
     /// any (kept for this step's [`Protection::bounds`]).
+    // Out of line: an unprotected step only tests the Option (scripts/bench-target, flight
+    // config without protection: mission median/worst 1043/1083 inlined, 1013/1048 out of line).
+    #[inline(never)]
     pub(crate) fn advance(
         &mut self,
         command_mps: T,
@@ -320,6 +323,8 @@ impl<T: Real> Protection<T> {
     /// The bounds of this step, once per step (the load cell's sample of [`Protection::advance`]
     /// is used once). `model` is the law's state (None when the law did not run: the last
     /// model value stands in).
+    // Out of line, as `advance`.
+    #[inline(never)]
     pub(crate) fn bounds(
         &mut self,
         model: Option<&FreeTensionModel<T>>,
