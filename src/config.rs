@@ -156,7 +156,7 @@ pub struct Config<T> {
     pub envelope: Envelope<T>,
     /// Sensor checks and fault timing.
     pub monitor: MonitorConfig<T>,
-    /// Tension- and drive-aware protection (docs/equations.md §13); `None`: the paper's
+    /// Tension- and drive-aware protection (docs/equations.md §14); `None`: the paper's
     /// controller, bounded by the envelope alone.
     pub protection: Option<ProtectionConfig<T>>,
     /// Where the law's α and α̇ come from.

@@ -19,7 +19,7 @@
 //! f32 rounding of the sensed length.
 //!
 //! With the controller's protection (`crate::controller::ProtectionConfig`, docs/equations.md
-//! §13) two more bounds enter: the tension bound, a window of commands inside the acceleration
+//! §14) two more bounds enter: the tension bound, a window of commands inside the acceleration
 //! window (the acceleration limit wins where they disagree), and the drive's overrun: a drive
 //! with lag τ runs τ|v| beyond the commands before it stops, so the distance to a length limit
 //! is measured less that overrun, which makes the staircase exact for the drive.
@@ -191,7 +191,7 @@ impl<T: Real> PreparedEnvelope<T> {
         // fits in the room left) the command passes as it is. (A negative room, past the
         // limit, is never far for a speed toward it; the braking curve sees it as zero.)
         // A lagging drive brakes on a staircase of a·(1 − e^{−h})/h per period: its peak
-        // acceleration, just after each step, is then a (docs/equations.md §13).
+        // acceleration, just after each step, is then a (docs/equations.md §14).
         let two = T::from_f64(2.0);
         let brake_mps2 = env.max_accel_mps2 * bounds.braking_fraction;
         let far = |v: T, room: T| {

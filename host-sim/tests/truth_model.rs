@@ -433,7 +433,7 @@ fn rigid_limit_reproduces_the_paper_mission_up_to_the_slew_end() {
 #[test]
 fn rigid_limit_reproduces_the_rate_limited_paper_mission() {
     // The envelope alone: the elastic loop here measures no tension, so the protection that
-    // paper-reel-limits.toml flies (docs/equations.md §13) would act on the rigid run only.
+    // paper-reel-limits.toml flies (docs/equations.md §14) would act on the rigid run only.
     let mut sc = scenario("paper-reel-limits");
     sc.protection.enabled = false;
     let rigid = fly_rigid(&sc);

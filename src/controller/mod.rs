@@ -42,7 +42,7 @@
 //! [`RateSource::Sensor`] (the paper's idealisation, [`Config::paper`], Table 1) flies the law
 //! on the sensed α and α̇. [`RateSource::Estimator`] ([`Config::flight`], the firmware's) flies
 //! it on α̂ and α̇̂ of the onboard EKF ([`crate::estimator`]) from α alone, stepped once per
-//! period inside the step (docs/equations.md §13): the estimate is carried over the period
+//! period inside the step (docs/equations.md §14): the estimate is carried over the period
 //! under the drive the last step commanded (or the encoder's measured rate), then updated with
 //! this period's α. For the fault logic:
 //!

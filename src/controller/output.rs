@@ -89,7 +89,7 @@ impl Flags {
     /// would end the progress for good and can slacken a short tether; the ground decides.
     pub const NO_PROGRESS: u32 = 1 << 8;
     /// The protection's tension bound restricted the command (or its reported acceleration):
-    /// the law asked for an acceleration the tether does not carry (docs/equations.md §13).
+    /// the law asked for an acceleration the tether does not carry (docs/equations.md §14).
     pub const TENSION_LIMITED: u32 = Saturation::TENSION;
 
     /// `true` if every bit of `mask` is set.

@@ -1,4 +1,4 @@
-//! Tension- and drive-aware protection (issue 18; docs/equations.md §13): the command is
+//! Tension- and drive-aware protection (issue 18; docs/equations.md §14): the command is
 //! bounded by what the tether carries and by what a lagging drive will actually do.
 //!
 //! **The tension bound.** Eq. 5a with the reel's acceleration l̈ split out,
@@ -79,7 +79,7 @@ pub struct ProtectionConfig<T> {
 }
 
 impl<T: Real> ProtectionConfig<T> {
-    /// Defaults for a real reel: T_min = 2 mN (docs/equations.md §13: 10 mN winds the paper's
+    /// Defaults for a real reel: T_min = 2 mN (docs/equations.md §14: 10 mN winds the paper's
     /// release back to docking, 5 mN deploys), T_max = 50 N (4× the mission's nominal peak),
     /// τ_f = 3600 s (a load cell of σ = 0.1 N then corrects the model to 1.2 mN), no drive lag.
     pub fn default_for_period() -> Self {
@@ -233,7 +233,7 @@ pub(crate) struct Protection<T> {
 /// gravity-gradient tension 3 m_r n² l: half of what the deployment's reference state (α_r =
 /// −45°, free tension 1.5 m_r n² l) has, so that the bound never holds the reel against the law
 /// at the reference (a fixed T_min above 1.5 m_r n² l winds a short tether in for ever:
-/// docs/equations.md §13).
+/// docs/equations.md §14).
 pub const MARGIN_OF_GRAVITY_GRADIENT: f64 = 0.25;
 
 impl<T: Real> Protection<T> {

@@ -1,5 +1,5 @@
 //! `[protection]`: the controller's tension- and drive-aware protection (docs/equations.md
-//! §13). Off by default (the paper's controller, Table 1 unchanged); when on, its rules are the
+//! §14). Off by default (the paper's controller, Table 1 unchanged); when on, its rules are the
 //! controller's (`ProtectionConfig::validate`, named by scenario key in `core_rules.rs`).
 
 use serde::{Deserialize, Serialize};
