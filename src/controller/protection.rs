@@ -664,6 +664,64 @@ mod tests {
         assert!(jump < 3e-6, "{jump}");
     }
 
+    /// A protected controller fed every special value in the load cell and the encoder's rate
+    /// (and a lagging drive model): every command finite, inside the envelope, each step
+    /// within the acceleration limit of the last (the length limits do not bind here).
+    #[test]
+    fn bad_tension_and_rate_samples_never_make_a_bad_command() {
+        use crate::controller::{Config, Controller, Input};
+        let specials = [
+            None,
+            Some(f32::NAN),
+            Some(f32::INFINITY),
+            Some(f32::NEG_INFINITY),
+            Some(f32::MAX),
+            Some(-f32::MAX),
+            Some(f32::MIN_POSITIVE),
+            Some(-1e5),
+            Some(0.0),
+            Some(3.0),
+        ];
+        for lag in [0.0, 2.0] {
+            let cfg = Config {
+                protection: Some(ProtectionConfig {
+                    drive_lag_s: lag,
+                    ..ProtectionConfig::default_for_period()
+                }),
+                envelope: crate::envelope::Envelope {
+                    max_rate_mps: 10.0,
+                    max_accel_mps2: 0.1,
+                    ..Config::<f32>::paper().envelope
+                },
+                ..Config::<f32>::paper()
+            };
+            let env = cfg.envelope;
+            let mut ctl = Controller::new(cfg).unwrap();
+            let mut previous = cfg.initial_rate_mps;
+            for tick in 0..400u32 {
+                let k = tick as usize;
+                let out = ctl.step(&Input {
+                    tick,
+                    length_m: 100.0 + 0.1 * tick as f32,
+                    reel_rate_mps: specials[(k * 7 + 3) % specials.len()],
+                    tension_n: specials[k % specials.len()],
+                    alpha_rad: Some(-0.7),
+                    alpha_rate_radps: Some(0.0),
+                    orbit_rate_radps: 1.06e-3,
+                    true_anomaly_rad: 0.0,
+                });
+                let y = out.rate_cmd_mps;
+                assert!(y.is_finite() && y.abs() <= env.max_rate_mps, "{tick}: {y}");
+                assert!(
+                    (y - previous).abs() <= env.max_accel_mps2 * 1.0001,
+                    "{tick}"
+                );
+                assert!(out.accel_cmd_mps2.is_finite());
+                previous = y;
+            }
+        }
+    }
+
     #[test]
     fn the_configuration_is_checked() {
         assert!(cfg(0.0).validate(1.0).is_ok());
