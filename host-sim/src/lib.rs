@@ -5,6 +5,7 @@ pub mod analysis;
 pub mod elastic;
 pub mod faults;
 pub mod history;
+pub mod laws;
 pub mod montecarlo;
 pub mod output;
 pub mod pil;

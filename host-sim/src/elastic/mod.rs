@@ -369,13 +369,35 @@ impl State {
 enum ReelDrive {
     /// l̇ imposed (ideal, lag, locked).
     Rate(f64),
-    /// The drum's speed loop with this speed command, motion and brake.
+    /// The drum's motor with this speed command (or tension command: [`motor_torque`]),
+    /// motion and brake.
     Drum {
         drum: DrumParams,
         command_radps: f64,
+        tension_n: Option<f64>,
         motion: Motion,
         brake: bool,
     },
+}
+
+/// The drum motor's torque and its speed loop's integrator rate: the speed loop's
+/// ([`DrumParams::speed_loop`]) under a rate command; under a tension command T (a tension law,
+/// `crate::laws`) the motor holds the tether back with −T·r (T ≥ 0: a tether only pulls),
+/// clamped to the torque limit, and the speed loop's integrator rests.
+fn motor_torque(
+    d: &DrumParams,
+    tension_n: Option<f64>,
+    command_radps: f64,
+    speed_radps: f64,
+    integral_rad: f64,
+) -> (f64, f64) {
+    match tension_n {
+        Some(t) => (
+            (-d.radius_m * t.max(0.0)).clamp(-d.max_torque_nm, d.max_torque_nm),
+            0.0,
+        ),
+        None => d.speed_loop(command_radps, speed_radps, integral_rad),
+    }
 }
 
 /// The angles of a direction in the centre of mass's orbit frame (docs/equations.md §0):
@@ -482,6 +504,9 @@ pub struct ElasticPlant {
     /// The control period the reel's saturation flags are judged over (the last one stepped;
     /// 1 s before the first), s.
     period_hint_s: f64,
+    /// The tension command of the current period (a tension law drives the drum's torque),
+    /// N; `None` under a rate command.
+    tension_cmd_n: Option<f64>,
     ws: Workspace,
 }
 
@@ -599,6 +624,7 @@ impl ElasticPlant {
             feeds: FeedCounts::default(),
             substeps_last: 0,
             period_hint_s: 1.0,
+            tension_cmd_n: None,
             ws: Workspace::default(),
         })
     }
@@ -860,6 +886,7 @@ impl ElasticPlant {
             ReelState::Motor { drum, motion } => ReelDrive::Drum {
                 drum,
                 command_radps: command / drum.radius_m,
+                tension_n: self.tension_cmd_n,
                 motion,
                 brake,
             },
@@ -892,7 +919,8 @@ impl ElasticPlant {
     /// One RK4 substep of `h` starting `t0` into the period, then the drum's stick/slip
     /// switch and the feeding rule.
     fn substep(&mut self, command: f64, t0: f64, h: f64) {
-        let brake = command == 0.0;
+        // The brake holds a zero rate command; a tension law commands the motor, never the brake.
+        let brake = command == 0.0 && self.tension_cmd_n.is_none();
         let motor = self.drum();
         if let Some(d) = motor {
             let drive = self.drum_drive_nm(&d, command);
@@ -982,7 +1010,9 @@ impl ElasticPlant {
 
     /// τ_m + r T_reel at the current state, N·m.
     fn drum_drive_nm(&self, d: &DrumParams, command: f64) -> f64 {
-        let (torque, _) = d.speed_loop(
+        let (torque, _) = motor_torque(
+            d,
+            self.tension_cmd_n,
             command / d.radius_m,
             self.y.drum_speed_radps,
             self.y.drum_integral_rad,
@@ -1114,11 +1144,17 @@ fn derivative(
         ReelDrive::Drum {
             drum: d,
             command_radps,
+            tension_n,
             motion,
             brake,
         } => {
-            let (torque, integral_rate) =
-                d.speed_loop(command_radps, y.drum_speed_radps, y.drum_integral_rad);
+            let (torque, integral_rate) = motor_torque(
+                &d,
+                tension_n,
+                command_radps,
+                y.drum_speed_radps,
+                y.drum_integral_rad,
+            );
             let drive = torque + d.radius_m * tension_reel;
             let accel = d.accel_radps2(motion, drive, y.drum_speed_radps, brake);
             (accel, integral_rate)
@@ -1227,6 +1263,7 @@ impl Plant for ElasticPlant {
 
     fn step(&mut self, command: &Command, period_s: f64) {
         self.period_hint_s = period_s;
+        self.tension_cmd_n = command.tension_n;
         // A non-finite state ends the period early; `is_finite` reports it to the loop.
         let _ = ElasticPlant::step(self, command.rate_mps, period_s);
     }
