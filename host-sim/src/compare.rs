@@ -370,6 +370,13 @@ pub fn compare(args: &CompareArgs) -> anyhow::Result<()> {
         }
     }
     let sc = Scenario::load(&args.scenario, &args.set)?;
+    if args.runs.is_some() && sc.montecarlo.dispersion.is_empty() {
+        return Err(UsageError(format!(
+            "--runs: {} has no [[montecarlo.dispersion]] to disperse",
+            args.scenario.display()
+        ))
+        .into());
+    }
     let scenarios: Vec<Scenario> = laws
         .iter()
         .map(|&l| with_law(&sc, l))

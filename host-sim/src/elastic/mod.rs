@@ -382,8 +382,11 @@ enum ReelDrive {
 
 /// The drum motor's torque and its speed loop's integrator rate: the speed loop's
 /// ([`DrumParams::speed_loop`]) under a rate command; under a tension command T (a tension law,
-/// `crate::laws`) the motor holds the tether back with −T·r (T ≥ 0: a tether only pulls),
-/// clamped to the torque limit, and the speed loop's integrator rests.
+/// `crate::laws`) the motor holds the tether back with −T·r (T ≥ 0: a tether only pulls) plus
+/// the turning drum's viscous and Coulomb friction (fed forward from its speed, so that the
+/// tether feels T: J ω̇ = r(T_reel − T) while it turns), clamped to the torque limit; the speed
+/// loop's integrator rests. A stuck drum breaks away once |r(T_reel − T)| exceeds its static
+/// friction.
 fn motor_torque(
     d: &DrumParams,
     tension_n: Option<f64>,
@@ -392,10 +395,12 @@ fn motor_torque(
     integral_rad: f64,
 ) -> (f64, f64) {
     match tension_n {
-        Some(t) => (
-            (-d.radius_m * t.max(0.0)).clamp(-d.max_torque_nm, d.max_torque_nm),
-            0.0,
-        ),
+        Some(t) => {
+            let friction = d.viscous_nms * speed_radps + d.coulomb_nm * speed_radps.signum();
+            let friction = if speed_radps == 0.0 { 0.0 } else { friction };
+            let torque = -d.radius_m * t.max(0.0) + friction;
+            (torque.clamp(-d.max_torque_nm, d.max_torque_nm), 0.0)
+        }
         None => d.speed_loop(command_radps, speed_radps, integral_rad),
     }
 }

@@ -18,8 +18,8 @@
 //! **Stages** as the paper's mission: l_f = `stage1.keep_length_m` (deployment and keep) until
 //! `stage2.start_time_s`, then `stage2.keep_length_m` (retrieval and keep). The phase reported
 //! is Deploy/Retrieve until l first comes within `controller.keep_capture_m` of l_f, then
-//! Keep1/Keep2. **Dropouts**: a period without a sample holds the last tension (health
-//! Degraded for that period). **Floor**: a tether only pulls: Rupp's command is floored at 0,
+//! Keep1/Keep2. **Dropouts**: a period without a sample, or with a non-finite length or orbit
+//! rate, holds the last tension (health Degraded for that period). **Floor**: a tether only pulls: Rupp's command is floored at 0,
 //! the tracking law's at its T_min > 0.
 
 pub mod rupp;
@@ -212,14 +212,17 @@ impl LawStepper {
 
 impl Stepper<f32> for LawStepper {
     fn step(&mut self, tick: u32, input: Option<&Input<f32>>) -> Result<Output<f32>, SimError> {
-        let (health, alpha, length) = match input {
+        // A reading the law cannot use (a non-finite length or orbit rate: a corrupted
+        // sample) is treated as no reading: the last tension is held.
+        let usable = input.filter(|x| x.length_m.is_finite() && x.orbit_rate_radps.is_finite());
+        let (health, alpha, length) = match usable {
             Some(x) => {
                 let s = self.sense(tick, x);
                 let target = self.sequence(tick, s.length_m);
                 self.tension_n = self.law.tension_n(&s, target);
                 (Health::Nominal, x.alpha_rad, x.length_m)
             }
-            // No sample: hold the last tension.
+            // No usable sample: hold the last tension.
             None => (
                 Health::Degraded,
                 self.template.delta_rad,
