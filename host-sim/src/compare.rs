@@ -5,7 +5,7 @@
 //! with `--runs`) and overlaid figures of the nominal runs (`compare.png`/`.svg`: length, α,
 //! tension and reel rate against time).
 //!
-//! The metrics of a run ([`LawMetrics`], docs/equations.md §12.3):
+//! The metrics of a run ([`LawMetrics`], docs/equations.md §15.3):
 //! - time to reach the target: first l ≥ stage1.keep_length_m − 0.5 m (the run summary's
 //!   landmark, `crate::report`);
 //! - overshoot: the largest stage-1 length above the keep length, once reached;

@@ -1,5 +1,5 @@
 //! The classic deployment laws beside the paper's, as a simulator concept (`[controller] law`):
-//! the laws that command the reel's **tension** rather than its rate (docs/equations.md §12).
+//! the laws that command the reel's **tension** rather than its rate (docs/equations.md §15).
 //!
 //! - [`rupp`]: Rupp's tension law T = m_e Ω²[a(l − l_f) + b l̇/Ω + c l_f] (NASA TM X-64963).
 //! - [`tracking`]: a saturated tension law with an explicit positive-tension constraint,

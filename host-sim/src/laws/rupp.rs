@@ -1,6 +1,6 @@
 //! Rupp's tension law (C. C. Rupp, "A tether tension control law for tethered subsatellites
 //! deployed along local vertical", NASA TM X-64963, 1975; patented with R. R. Kissel,
-//! "Tetherline system for orbiting satellites", 1976–78), docs/equations.md §12.1:
+//! "Tetherline system for orbiting satellites", 1976–78), docs/equations.md §15.1:
 //!
 //!   T_c = m_e Ω² [a (l − l_f) + b l̇/Ω + c l_f]
 //!

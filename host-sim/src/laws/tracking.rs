@@ -1,5 +1,5 @@
 //! A saturated tension law with an explicit positive-tension constraint, tracking a length-rate
-//! schedule through Eq. 5a (docs/equations.md §12.2).
+//! schedule through Eq. 5a (docs/equations.md §15.2).
 //!
 //! **Schedule** l̇_ref(l): deploying (l < l_f) the exponential deployment of Modi & Misra
 //! (Acta Astronautica 6, 1979: l̇ = kΩl keeps l̇/l, hence the Eq. 7 equilibrium angle,

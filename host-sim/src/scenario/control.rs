@@ -22,7 +22,7 @@ pub struct ControllerSection {
     pub keep_capture_m: f64,
     /// The deployment law flown: `"paper"` (default: the flight core's Eqs. 27–35), `"rupp"`
     /// (Rupp's tension law) or `"tracking"` (a saturated, feedback-linearised tension law);
-    /// see `crate::laws` and docs/equations.md §12.
+    /// see `crate::laws` and docs/equations.md §15.
     #[serde(default)]
     pub law: LawName,
     /// `[controller.rupp]`: the gains of Rupp's tension law (`law = "rupp"`).
@@ -78,7 +78,7 @@ impl LawName {
 
 /// `[controller.rupp]`: T = m_e Ω²[a(l − l_f) + b l̇/Ω + c l_f] (Rupp 1975), one set of gains
 /// for both stages. Defaults: a = 4, b = 2, c = 3 (c = 3 makes l_f the law's equilibrium; the
-/// linearised loop is stable for a > 3, b > 0: docs/equations.md §12).
+/// linearised loop is stable for a > 3, b > 0: docs/equations.md §15).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RuppSection {
