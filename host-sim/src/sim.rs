@@ -208,6 +208,7 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
     let mut held = Command {
         rate_mps: sc.initial.length_rate_mps,
         accel_mps2: 0.0,
+        tension_n: None,
     };
     let mut last_length_m: Option<f64> = None;
     for tick in 0..=total {

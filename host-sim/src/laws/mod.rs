@@ -11,7 +11,7 @@
 //! reach them the same way), against either plant, in the same missions and Monte Carlo
 //! campaigns. Each period a law reads the sensed length, the reel's rate (the encoder's rate
 //! when the sample has one, else the backward difference of the sensed lengths) and the orbit
-//! rate, and commands a tension that the plant's reel holds over the period (zero-order hold):
+//! rate (`Input::alpha_rad` is only reported: neither law feeds back on α), and commands a tension that the plant's reel holds over the period (zero-order hold):
 //! the rigid plant integrates l̈ from Eq. 5a under it, the elastic plant's drum motor applies
 //! the torque T·r (`crate::plant::Command::tension_n`).
 //!
@@ -172,23 +172,28 @@ impl LawStepper {
         }))
     }
 
-    /// The law's reading of a sample: the sensed values, with the reel's rate from the
-    /// backward difference of the sensed lengths (kept from the last period at the first
-    /// sample).
+    /// The law's reading of a sample: the sensed values, with the reel's rate from its encoder
+    /// when the sample has it, else from the backward difference of the sensed lengths (kept
+    /// from the last period at the first sample).
     fn sense(&mut self, tick: u32, x: &Input<f32>) -> Sensed {
         let l = f64::from(x.length_m);
-        if let Some((t0, l0)) = self.last_length {
-            let dt = f64::from(tick.saturating_sub(t0)) * self.period_s;
-            if dt > 0.0 {
-                self.rate_mps = (l - l0) / dt;
+        match x.reel_rate_mps.map(f64::from).filter(|v| v.is_finite()) {
+            Some(v) => self.rate_mps = v,
+            None => {
+                if let Some((t0, l0)) = self.last_length {
+                    let dt = f64::from(tick.saturating_sub(t0)) * self.period_s;
+                    if dt > 0.0 {
+                        self.rate_mps = (l - l0) / dt;
+                    }
+                }
             }
         }
         self.last_length = Some((tick, l));
         Sensed {
             length_m: l,
             rate_mps: self.rate_mps,
-            alpha_rad: Some(f64::from(x.alpha_rad)),
-            alpha_rate_radps: Some(f64::from(x.alpha_rate_radps)),
+            alpha_rad: x.alpha_rad.map(f64::from),
+            alpha_rate_radps: x.alpha_rate_radps.map(f64::from),
             orbit_rate_radps: f64::from(x.orbit_rate_radps),
         }
     }
@@ -220,7 +225,7 @@ impl Stepper<f32> for LawStepper {
                 let s = self.sense(tick, x);
                 let target = self.sequence(tick, s.length_m);
                 self.tension_n = self.law.tension_n(&s, target);
-                (Health::Nominal, x.alpha_rad, x.length_m)
+                (Health::Nominal, x.alpha_rad.unwrap_or(0.0), x.length_m)
             }
             // No usable sample: hold the last tension.
             None => (
