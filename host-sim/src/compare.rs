@@ -578,14 +578,14 @@ fn draw_panel<DB: DrawingBackend>(
     }
     for (law, points) in curves {
         let color = LAW_COLORS[LawName::ALL.iter().position(|l| l == law).unwrap_or(0)];
-        let finite = points
-            .iter()
-            .copied()
-            .filter(|p| p.0.is_finite() && p.1.is_finite());
-        chart
-            .draw_series(LineSeries::new(finite, color.stroke_width(2)))?
-            .label(law.as_str())
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 24, y)], color.stroke_width(2)));
+        for (i, piece) in pieces(points).into_iter().enumerate() {
+            let drawn = chart.draw_series(LineSeries::new(piece, color.stroke_width(2)))?;
+            if i == 0 {
+                drawn.label(law.as_str()).legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 24, y)], color.stroke_width(2))
+                });
+            }
+        }
     }
     chart
         .configure_series_labels()
@@ -595,6 +595,30 @@ fn draw_panel<DB: DrawingBackend>(
         .border_style(BLACK)
         .draw()?;
     Ok(())
+}
+
+/// The finite points of a curve in pieces, cut where a value is not finite or jumps by more
+/// than 180 (α wrapping from −180° to 180° is a tumble through the vertical, not a line across
+/// the panel).
+fn pieces(points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
+    let mut out: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+    for &p in points {
+        let finite = p.0.is_finite() && p.1.is_finite();
+        let jump = out
+            .last()
+            .and_then(|c| c.last())
+            .is_some_and(|q| (p.1 - q.1).abs() > 180.0);
+        if (!finite || jump) && out.last().is_some_and(|c| !c.is_empty()) {
+            out.push(Vec::new());
+        }
+        if finite {
+            if let Some(c) = out.last_mut() {
+                c.push(p);
+            }
+        }
+    }
+    out.retain(|c| !c.is_empty());
+    out
 }
 
 /// The plant's reel rate (m/s) from the recorded lengths, against time (h).
@@ -609,4 +633,38 @@ fn rates(samples: &[Sample]) -> Vec<(f64, f64)> {
             )
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn curves_are_cut_at_wraps_and_gaps() {
+        let p = [
+            (0.0, 170.0),
+            (1.0, 179.0),
+            (2.0, -179.0),
+            (3.0, f64::NAN),
+            (4.0, 1.0),
+        ];
+        assert_eq!(
+            pieces(&p),
+            vec![
+                vec![(0.0, 170.0), (1.0, 179.0)],
+                vec![(2.0, -179.0)],
+                vec![(4.0, 1.0)]
+            ]
+        );
+        assert!(pieces(&[]).is_empty());
+    }
+
+    #[test]
+    fn angles_wrap_to_a_half_open_turn() {
+        assert_eq!(wrapped_deg(0.0), 0.0);
+        assert!((wrapped_deg(std::f64::consts::PI) - 180.0).abs() < 1e-12);
+        assert!((wrapped_deg(-std::f64::consts::PI) - 180.0).abs() < 1e-12);
+        assert!((wrapped_deg(-1.5 * std::f64::consts::PI) - 90.0).abs() < 1e-12);
+        assert!((wrapped_deg(3.0 * std::f64::consts::PI / 2.0) + 90.0).abs() < 1e-12);
+    }
 }

@@ -39,8 +39,8 @@ fn first_at_least(h: &History, level: f64) -> Option<f64> {
         .map(|x| x.t_s)
 }
 
-/// Rupp's law started as Rupp's deployments were, on the local vertical with a push (α(0) = 0,
-/// 10 m at 3 m/s), deploys to 30 km and holds it; the tension never goes below its floor.
+/// Rupp's law started on the local vertical (the TM's subject) with a push (α(0) = 0, 10 m at
+/// 3 m/s), deploys to 30 km and holds it; the tension never goes below its floor.
 #[test]
 fn rupps_law_deploys_from_a_vertical_start_and_keeps() {
     let sc = load(
