@@ -331,3 +331,29 @@ fn the_default_law_is_the_papers() {
         assert_eq!(LawName::parse(l.as_str()), Some(l));
     }
 }
+
+/// `run --pil` flies the flight firmware, whose law is the paper's: a simulator law is refused
+/// before QEMU starts (exit 2).
+#[test]
+fn pil_refuses_a_simulator_law() {
+    let tmp = tempfile::tempdir().unwrap();
+    let elf = tmp.path().join("fw.elf");
+    std::fs::write(&elf, b"not run").unwrap();
+    let o = tss_sim(&[
+        "run",
+        scenario_path("paper").to_str().unwrap(),
+        "--pil",
+        "--firmware",
+        elf.to_str().unwrap(),
+        "--set",
+        r#"controller.law="rupp""#,
+        "-o",
+        tmp.path().join("o").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("controller.law"),
+        "{}",
+        text(&o.stderr)
+    );
+}
