@@ -382,23 +382,34 @@ enum ReelDrive {
 
 /// The drum motor's torque and its speed loop's integrator rate: the speed loop's
 /// ([`DrumParams::speed_loop`]) under a rate command; under a tension command T (a tension law,
-/// `crate::laws`) the motor holds the tether back with −T·r (T ≥ 0: a tether only pulls) plus
-/// the turning drum's viscous and Coulomb friction (fed forward from its speed, so that the
-/// tether feels T: J ω̇ = r(T_reel − T) while it turns), clamped to the torque limit; the speed
-/// loop's integrator rests. A stuck drum breaks away once |r(T_reel − T)| exceeds its static
-/// friction.
+/// `crate::laws`) the motor holds the tether back with −T·r (T ≥ 0: a tether only pulls) and
+/// compensates its drum's friction from the drum's model: while the drum turns, the viscous and
+/// Coulomb friction fed forward from its speed (so J ω̇ = r(T_reel − T) while it turns); while
+/// it is stuck, the breakaway torque in the direction the tether's pull `reel_tension_n` − T
+/// would turn it (the tension at the reel is measured: the load cell of the controller's
+/// input). Clamped to the torque limit; the speed loop's integrator rests.
 fn motor_torque(
     d: &DrumParams,
     tension_n: Option<f64>,
+    reel_tension_n: f64,
     command_radps: f64,
     speed_radps: f64,
     integral_rad: f64,
 ) -> (f64, f64) {
     match tension_n {
         Some(t) => {
-            let friction = d.viscous_nms * speed_radps + d.coulomb_nm * speed_radps.signum();
-            let friction = if speed_radps == 0.0 { 0.0 } else { friction };
-            let torque = -d.radius_m * t.max(0.0) + friction;
+            let t = t.max(0.0);
+            let friction = if speed_radps != 0.0 {
+                d.viscous_nms * speed_radps + d.coulomb_nm * speed_radps.signum()
+            } else {
+                let pull = reel_tension_n - t;
+                if pull != 0.0 {
+                    d.static_nm * pull.signum()
+                } else {
+                    0.0
+                }
+            };
+            let torque = -d.radius_m * t + friction;
             (torque.clamp(-d.max_torque_nm, d.max_torque_nm), 0.0)
         }
         None => d.speed_loop(command_radps, speed_radps, integral_rad),
@@ -1022,13 +1033,6 @@ impl ElasticPlant {
 
     /// τ_m + r T_reel at the current state, N·m.
     fn drum_drive_nm(&self, d: &DrumParams, command: f64) -> f64 {
-        let (torque, _) = motor_torque(
-            d,
-            self.tension_cmd_n,
-            command / d.radius_m,
-            self.y.drum_speed_radps,
-            self.y.drum_integral_rad,
-        );
         let y = &self.y;
         let dvec = y.pos[1] - y.pos[0];
         let chord = dvec.norm();
@@ -1042,6 +1046,14 @@ impl ElasticPlant {
             .p
             .tether
             .tension_n(chord, rate, l, d.radius_m * y.drum_speed_radps);
+        let (torque, _) = motor_torque(
+            d,
+            self.tension_cmd_n,
+            tension,
+            command / d.radius_m,
+            y.drum_speed_radps,
+            y.drum_integral_rad,
+        );
         torque + d.radius_m * tension
     }
 
@@ -1163,6 +1175,7 @@ fn derivative(
             let (torque, integral_rate) = motor_torque(
                 &d,
                 tension_n,
+                tension_reel,
                 command_radps,
                 y.drum_speed_radps,
                 y.drum_integral_rad,
