@@ -344,3 +344,41 @@ fn pil_refuses_a_simulator_law() {
         text(&o.stderr)
     );
 }
+
+/// `tss-sim montecarlo` flies the scenario's law: the same campaign with the tracking law has
+/// the tracking law's outcomes (never slack: its floor), where the paper's law's differ.
+#[test]
+fn montecarlo_flies_the_scenarios_law() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sc = scenario_path("paper-montecarlo");
+    let run = |law: &str, dir: &Path| {
+        let set = format!("controller.law=\"{law}\"");
+        let o = tss_sim(&[
+            "montecarlo",
+            sc.to_str().unwrap(),
+            "--runs",
+            "2",
+            "--seed",
+            "3",
+            "--no-figures",
+            "-q",
+            "--out",
+            dir.to_str().unwrap(),
+            "--set",
+            "simulation.duration_s=7200",
+            "--set",
+            &set,
+        ]);
+        assert!(o.status.success(), "{law}: {}", text(&o.stderr));
+        std::fs::read_to_string(dir.join("runs.csv")).unwrap()
+    };
+    let tracking = run("tracking", &tmp.path().join("t"));
+    let paper = run("paper", &tmp.path().join("p"));
+    assert_ne!(tracking, paper);
+    let header: Vec<&str> = tracking.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "min_tension_n").unwrap();
+    for row in tracking.lines().skip(1) {
+        let t: f64 = row.split(',').nth(col).unwrap().parse().unwrap();
+        assert!(t >= 0.01 - 1e-12, "{row}");
+    }
+}
