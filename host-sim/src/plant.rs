@@ -633,6 +633,38 @@ mod tests {
         }
     }
 
+    /// Energy under a tension-commanded reel: on a circular orbit with a massless tether, in the
+    /// orbit plane, Eqs. 5a–5b conserve H = ½m_r(l̇² + l²α̇²) − (3/2)m_r n² l² cos²α but for the
+    /// tension's power: dH/dt = −T l̇. With T held over each period the work is T·Δl exactly,
+    /// so H(t) − H(0) + Σ T_k Δl_k vanishes to the integrator's error, whatever T does.
+    #[test]
+    fn a_tension_commanded_reel_does_exactly_the_work_the_energy_loses() {
+        let p = paper_plant();
+        let n = p.orbit.mean_motion_radps();
+        let m_r = p.masses.coefficients(1.0).radial_kg;
+        let energy = |x: &State, v: f64| {
+            let (l, a, w) = (x[ix::LENGTH], x[ix::ALPHA], x[ix::ALPHA_RATE]);
+            0.5 * m_r * (v * v + l * l * w * w) - 1.5 * m_r * n * n * l * l * a.cos().powi(2)
+        };
+        let (mut x, mut v) = (State::from([0.0, 2_000.0, -0.3, 1e-4, 0.0, 0.0]), 1.5);
+        let h0 = energy(&x, v);
+        let mut work = 0.0;
+        let mut scale: f64 = h0.abs();
+        for k in 0..20_000 {
+            // A tension that pays out, brakes and winds in over the run.
+            let t = 3.0 * m_r * n * n * x[ix::LENGTH] * (1.0 + 0.5 * (f64::from(k) * 1e-3).sin());
+            let l0 = x[ix::LENGTH];
+            for _ in 0..4 {
+                (x, v) = p.rk4_step_tension(&x, v, t, 0.25);
+            }
+            work += t * (x[ix::LENGTH] - l0);
+            scale = scale.max(work.abs());
+        }
+        let residual = energy(&x, v) - h0 + work;
+        assert!(residual.abs() < 1e-9 * scale, "{residual} of {scale}");
+        assert!(work.abs() > 1.0, "the tension did work: {work}");
+    }
+
     #[test]
     fn local_vertical_at_rest_is_an_equilibrium() {
         let p = paper_plant();
