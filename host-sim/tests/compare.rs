@@ -454,3 +454,26 @@ fn rupps_keep_decays_at_its_linear_loops_slowest_root() {
         "decay {slope:e}/s, linear analysis {expect:e}/s"
     );
 }
+
+/// On the elastic plant a tension the drum motor cannot hold (T·r beyond its torque limit) is
+/// reported as the reel's saturation, as a rate the speed loop cannot follow is; the speed
+/// loop's demand is not (it does not run under a tension command).
+#[test]
+fn a_tension_beyond_the_motors_torque_is_reported_as_saturation() {
+    let fly_with = |torque: &str| {
+        let sc = load(
+            "paper-elastic",
+            &[
+                r#"controller.law="tracking""#,
+                "simulation.duration_s=600",
+                &format!("reel.motor_max_torque_nm={torque}"),
+            ],
+        );
+        fly(&sc).faults.reel_accel_saturated_ticks
+    };
+    // The floor 0.01 N on a 0.1 m drum needs 0.001 N·m; the first 600 s need well below
+    // 0.02 N·m (the speed loop's friction hold, 0.051 N·m, is not what a tension law asks).
+    assert!(fly_with("0.0005") > 500);
+    assert_eq!(fly_with("0.02"), 0);
+    assert_eq!(fly_with("2.0"), 0);
+}

@@ -1257,6 +1257,20 @@ impl ElasticPlant {
     }
 }
 
+impl ElasticPlant {
+    /// Which limits act on a tension command `tension_n`: the motor's torque limit (reported as
+    /// an acceleration limit) when T·r exceeds it; no rate limit.
+    pub fn tension_saturation(&self, tension_n: f64) -> ReelSaturation {
+        match self.reel {
+            ReelState::Motor { drum: d, .. } => ReelSaturation {
+                rate: false,
+                accel: d.radius_m * tension_n.max(0.0) > d.max_torque_nm,
+            },
+            _ => ReelSaturation::default(),
+        }
+    }
+}
+
 impl Plant for ElasticPlant {
     fn observe(&self, command: &Command) -> Observation {
         let m = self.measure();
@@ -1275,7 +1289,10 @@ impl Plant for ElasticPlant {
             alpha_rate_radps: m.line.alpha_rate_radps,
             beta_rad: m.line.beta_rad,
             tension_n: m.tension_reel_n,
-            reel: self.reel_saturation(command.rate_mps, period),
+            reel: match command.tension_n {
+                Some(t) => self.tension_saturation(t),
+                None => self.reel_saturation(command.rate_mps, period),
+            },
             elastic: Some(ElasticObservation {
                 range_m: m.range_m,
                 tension_tip_n: m.tension_tip_n,
