@@ -93,17 +93,26 @@ impl TensionLaw {
         }
     }
 
-    /// The commanded tension toward `target_m`, N: finite and ≥ 0 (the floor; a non-finite
-    /// value, from a non-finite reading, becomes the floor too).
+    /// The smallest tension the law commands, N: Rupp's 0 (a tether only pulls), the tracking
+    /// law's T_min > 0.
+    pub fn floor_n(&self) -> f64 {
+        match self {
+            Self::Rupp(_) => 0.0,
+            Self::Tracking(t) => t.params.min_tension_n,
+        }
+    }
+
+    /// The commanded tension toward `target_m`, N: finite and ≥ [`TensionLaw::floor_n`] (a
+    /// non-finite value, from a non-finite reading, becomes the floor too).
     pub fn tension_n(&self, s: &Sensed, target_m: f64) -> f64 {
-        let (t, floor) = match self {
-            Self::Rupp(r) => (r.tension_n(s, target_m), 0.0),
-            Self::Tracking(t) => (t.saturated_tension_n(s, target_m), t.params.min_tension_n),
+        let t = match self {
+            Self::Rupp(r) => r.tension_n(s, target_m),
+            Self::Tracking(t) => t.saturated_tension_n(s, target_m),
         };
         if t.is_finite() {
-            t.max(floor)
+            t.max(self.floor_n())
         } else {
-            floor
+            self.floor_n()
         }
     }
 
@@ -136,7 +145,7 @@ pub struct LawStepper {
     last_length: Option<(u32, f64)>,
     /// The rate used last, m/s (the scenario's initial rate before the first difference).
     rate_mps: f64,
-    /// The tension held, N.
+    /// The tension held, N (the law's floor before the first usable sample).
     tension_n: f64,
     phase: Phase,
     /// An idle flight controller's output: the fields a tension law has no use for keep its
@@ -166,7 +175,8 @@ impl LawStepper {
             period_s: sc.controller.period_s,
             last_length: None,
             rate_mps: sc.initial.length_rate_mps,
-            tension_n: 0.0,
+            // Before the first usable sample: the law's floor.
+            tension_n: law.floor_n(),
             phase: Phase::Deploy,
             template,
         }))
@@ -220,18 +230,25 @@ impl Stepper<f32> for LawStepper {
         // A reading the law cannot use (a non-finite length or orbit rate: a corrupted
         // sample) is treated as no reading: the last tension is held.
         let usable = input.filter(|x| x.length_m.is_finite() && x.orbit_rate_radps.is_finite());
-        let (health, alpha, length) = match usable {
+        let (health, alpha, length, rate_ref) = match usable {
             Some(x) => {
                 let s = self.sense(tick, x);
                 let target = self.sequence(tick, s.length_m);
                 self.tension_n = self.law.tension_n(&s, target);
-                (Health::Nominal, x.alpha_rad.unwrap_or(0.0), x.length_m)
+                let rate_ref = self.law.rate_ref_mps(&s, target) as f32;
+                (
+                    Health::Nominal,
+                    x.alpha_rad.unwrap_or(0.0),
+                    x.length_m,
+                    rate_ref,
+                )
             }
             // No usable sample: hold the last tension.
             None => (
                 Health::Degraded,
                 self.template.delta_rad,
                 self.last_length.map_or(0.0, |(_, l)| l as f32),
+                0.0,
             ),
         };
         Ok(Output {
@@ -240,7 +257,8 @@ impl Stepper<f32> for LawStepper {
             health,
             rate_cmd_mps: self.rate_mps as f32,
             accel_cmd_mps2: 0.0,
-            law_rate_mps: 0.0,
+            // The history's law_rate column: the rate the law aims at.
+            law_rate_mps: rate_ref,
             blend_weight: 0.0,
             alpha_ref_rad: 0.0,
             alpha_ref_rate_radps: 0.0,
