@@ -108,7 +108,7 @@ impl<T: Real> ProtectionConfig<T> {
             ));
         }
         crate::config::at_least("protection.drive_lag_s", self.drive_lag_s, T::ZERO)?;
-        if self.max_tension_n.to_f64() > MAX_PLAUSIBLE_TENSION_N {
+        if self.max_tension_n > T::from_f64(MAX_PLAUSIBLE_TENSION_N) {
             return Err(ConfigError::new(
                 "protection.max_tension_n",
                 self.max_tension_n,
@@ -245,20 +245,22 @@ impl<T: Real> Protection<T> {
         max_rate_mps: T,
         initial_rate_mps: T,
     ) -> Self {
-        let dt = period_s.to_f64();
-        let lag_s = cfg.drive_lag_s.to_f64();
-        let lag = (lag_s > 0.0).then(|| {
-            let h = dt / lag_s;
+        // In T (no f64 exponentials on the target: libm's exp and expm1 in f64 were 5 KB of
+        // the flight firmware's flash). (e^{−h}, 1 − e^{−h}), the second without cancellation.
+        let tau = cfg.drive_lag_s;
+        let lag = (tau > T::ZERO).then(|| {
+            let h = period_s / tau;
+            let (decay, complement) = (-h).exp_and_complement();
             Lag {
-                lag_s: cfg.drive_lag_s,
-                inv_lag_per_s: T::from_f64(1.0 / lag_s),
-                decay: T::from_f64(libm::exp(-h)),
-                mean_to_end: T::from_f64(h / libm::expm1(h)),
-                periods_per_lag: T::from_f64(h),
-                ramp_fraction: T::from_f64(-libm::expm1(-h) / h),
+                lag_s: tau,
+                inv_lag_per_s: T::ONE / tau,
+                decay,
+                mean_to_end: h * decay / complement,
+                periods_per_lag: h,
+                ramp_fraction: complement / h,
             }
         });
-        let tf = cfg.tension_filter_s.to_f64();
+        let filter_gain = (-period_s / cfg.tension_filter_s).exp_and_complement().1;
         let radial = masses.coefficients(T::ZERO).radial_kg;
         Self {
             cfg,
@@ -267,7 +269,7 @@ impl<T: Real> Protection<T> {
             masses,
             radial_kg: radial,
             inv_radial_per_kg: T::ONE / radial,
-            filter_gain: T::from_f64(-libm::expm1(-dt / tf)),
+            filter_gain,
             drive_rate_mps: initial_rate_mps,
             drive_accel_mps2: T::ZERO,
             correction_n: T::ZERO,
