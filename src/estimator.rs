@@ -735,19 +735,21 @@ impl<T: Real> Estimator<T> {
         })
     }
 
-    /// The update with this period's sample (module docs, *Gating*, *Covariance*).
+    /// The update with this period's sample (module docs, *Gating*, *Covariance*), in place.
     fn update(&mut self, sample: Option<T>) -> Measurement<T> {
         let Some(z) = sample else {
             return Measurement::Missing;
         };
-        if z.is_nan() || z.abs() > T::from_f64(core::f64::consts::PI) {
+        // One comparison: false for NaN.
+        if !(z.abs() <= T::from_f64(core::f64::consts::PI)) {
             return Measurement::Invalid;
         }
-        let Some(t) = self.track else {
+        let r = self.measurement_var;
+        let (gate_nis, max_rejections) = (self.config.gate_nis, self.config.max_rejections);
+        let Some(t) = &mut self.track else {
             self.track = Some(self.start(z, T::ZERO, T::ZERO));
             return Measurement::Initialised;
         };
-        let r = self.measurement_var;
         let nu = z - t.alpha;
         let var = t.p.aa + r;
         let inv = T::ONE / var;
@@ -756,28 +758,33 @@ impl<T: Real> Estimator<T> {
             variance_rad2: var,
             nis: nu * nu * inv,
         };
-        if innovation.nis > self.config.gate_nis {
-            if t.rejections >= self.config.max_rejections {
-                self.track = Some(self.start(z, t.rate, t.disturbance));
+        if innovation.nis > gate_nis {
+            if t.rejections >= max_rejections {
+                let (rate, disturbance) = (t.rate, t.disturbance);
+                self.track = Some(self.start(z, rate, disturbance));
                 return Measurement::Reinitialised(innovation);
             }
-            self.track = Some(Track {
-                rejections: t.rejections + 1,
-                ..t
-            });
+            t.rejections += 1;
             return Measurement::Gated(innovation);
         }
         // K = P Hᵀ / S, H = (1 0 0).
         let gain = [t.p.aa * inv, t.p.aw * inv, t.p.ad * inv];
-        self.track = Some(Track {
-            alpha: t.alpha + gain[0] * nu,
-            rate: t.rate + gain[1] * nu,
-            disturbance: t.disturbance + gain[2] * nu,
-            p: t.p.joseph(&gain, r),
-            rejections: 0,
-            trig: None,
-        });
+        t.alpha = t.alpha + gain[0] * nu;
+        t.rate = t.rate + gain[1] * nu;
+        t.disturbance = t.disturbance + gain[2] * nu;
+        t.p = t.p.joseph(&gain, r);
+        t.rejections = 0;
+        t.trig = None;
         Measurement::Accepted(innovation)
+    }
+}
+
+/// `v` if it is at least 0, else 0 (NaN included): `v.max(0)` in one comparison.
+fn non_negative<T: Real>(v: T) -> T {
+    if v >= T::ZERO {
+        v
+    } else {
+        T::ZERO
     }
 }
 
@@ -926,12 +933,12 @@ impl<T: Real> Sym3<T> {
         let s = p.aa + r;
         let c = [p.aa - s * k[0], p.aw - s * k[1], p.ad - s * k[2]];
         Self {
-            aa: (p.aa - k[0] * c[0] - p.aa * k[0]).max(T::ZERO),
+            aa: non_negative(p.aa - k[0] * c[0] - p.aa * k[0]),
             aw: p.aw - k[0] * c[1] - p.aa * k[1],
             ad: p.ad - k[0] * c[2] - p.aa * k[2],
-            ww: (p.ww - k[1] * c[1] - p.aw * k[1]).max(T::ZERO),
+            ww: non_negative(p.ww - k[1] * c[1] - p.aw * k[1]),
             wd: p.wd - k[1] * c[2] - p.aw * k[2],
-            dd: (p.dd - k[2] * c[2] - p.ad * k[2]).max(T::ZERO),
+            dd: non_negative(p.dd - k[2] * c[2] - p.ad * k[2]),
         }
     }
 }
