@@ -173,8 +173,9 @@ impl<T: Real> Estimation<T> {
             let last_lost = periods > 0 && self.carry(periods - 1, reel_rate_mps);
             gap_lost || last_lost
         };
-        let m = self.filter.update_with(alpha_rad);
-        let estimate = self.filter.estimate();
+        // The monitor checked α: |α| ≤ π.
+        let m = self.filter.update_with_angle(alpha_rad);
+        let estimate = self.filter.alpha_rate_and_variance();
         let (nis, event) = match m {
             Measurement::Accepted(i) | Measurement::Gated(i) => (Some(i.nis), None),
             Measurement::Reinitialised(i) => (Some(i.nis), Some(EventKind::EstimateRestarted)),
@@ -192,10 +193,12 @@ impl<T: Real> Estimation<T> {
         ) {
             self.useless = false;
         }
-        let verdict = match (m, &estimate) {
+        let verdict = match (m, estimate) {
             (Measurement::Gated(_), _) => Estimated::Unusable(Sensor::AlphaGated),
-            (_, Some(e)) if !self.useless && e.alpha_var_rad2 <= self.max_alpha_var_rad2 => {
-                Estimated::Usable(e.alpha_rad, e.alpha_rate_radps)
+            (_, Some((alpha_rad, alpha_rate_radps, alpha_var_rad2)))
+                if !self.useless && alpha_var_rad2 <= self.max_alpha_var_rad2 =>
+            {
+                Estimated::Usable(alpha_rad, alpha_rate_radps)
             }
             _ => {
                 self.useless = true;
