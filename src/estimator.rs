@@ -113,11 +113,12 @@
 //! Plain scalars on the structure, not nalgebra matrices: Φ's d row is e₃ᵀ and P is symmetric,
 //! so Φ P Φᵀ is 30 multiply-adds on the 6 stored entries; Ψ and Φ share two polynomials of the
 //! series (12 operations), and the Joseph update for H = (1 0 0), regrouped, is 15 multiply-adds;
-//! one sin_cos (of 2α̂, lent by the law in the controller) and two divisions a step. On the Cortex-M4F
-//! (`examples/bench_estimator.rs`, flight profile, over the paper mission) a step takes 408
-//! instructions with a sample (median; 445 at worst, in the first ticks, where the α̇
-//! variance sits at its cap), 318 in a dropout and 348 with a gated sample; nalgebra's general
-//! 3×3 forms of the two covariance products alone take 815 (Φ P Φᵀ + Q) and 1 170 (Joseph)
+//! one sin_cos (of 2α̂, lent by the law in the controller) and two divisions a step. On the
+//! Cortex-M4F (`examples/bench_estimator.rs`, flight profile, over the paper mission) a step
+//! takes 355 instructions with a sample (median; 370 at worst, in the first ticks, where the α̇
+//! variance sits at its cap), 275 in a dropout and 300 with a gated sample (408/445, 318 and 348
+//! before issue 18's budget round); nalgebra's general 3×3 forms of the two covariance products
+//! alone take 815 (Φ P Φᵀ + Q) and 1 170 (Joseph)
 //! at opt-level "s".
 
 use crate::real::Real;
