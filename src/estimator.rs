@@ -598,7 +598,9 @@ impl<T: Real> Estimator<T> {
         match alpha_rad {
             None => Measurement::Missing,
             // One comparison: false for NaN.
-            Some(z) if !(z.abs() <= T::from_f64(core::f64::consts::PI)) => Measurement::Invalid,
+            Some(z) if above_or_nan(z.abs(), T::from_f64(core::f64::consts::PI)) => {
+                Measurement::Invalid
+            }
             Some(z) => self.update(z),
         }
     }
@@ -796,6 +798,12 @@ impl<T: Real> Estimator<T> {
     }
 }
 
+/// `v` above `cap`, or NaN: not `v ≤ cap`, in one comparison.
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN is meant to count as above
+fn above_or_nan<T: Real>(v: T, cap: T) -> bool {
+    !(v <= cap)
+}
+
 /// `v` if it is at least 0, else 0 (NaN included): `v.max(0)` in one comparison.
 fn non_negative<T: Real>(v: T) -> T {
     if v >= T::ZERO {
@@ -923,7 +931,7 @@ impl<T: Real> Sym3<T> {
         if p.aa <= caps[0] && p.ww <= caps[1] && p.dd <= caps[2] {
             return p;
         }
-        if !(p.aa <= caps[0]) {
+        if above_or_nan(p.aa, caps[0]) {
             if p.aa > caps[0] {
                 let r = caps[0] / p.aa;
                 p.aw = p.aw * r;
@@ -931,7 +939,7 @@ impl<T: Real> Sym3<T> {
             }
             p.aa = caps[0];
         }
-        if !(p.ww <= caps[1]) {
+        if above_or_nan(p.ww, caps[1]) {
             if p.ww > caps[1] {
                 let r = caps[1] / p.ww;
                 p.aw = p.aw * r;
@@ -939,7 +947,7 @@ impl<T: Real> Sym3<T> {
             }
             p.ww = caps[1];
         }
-        if !(p.dd <= caps[2]) {
+        if above_or_nan(p.dd, caps[2]) {
             if p.dd > caps[2] {
                 let r = caps[2] / p.dd;
                 p.ad = p.ad * r;
