@@ -284,7 +284,8 @@ impl<T: Real> Protection<T> {
     /// the encoder's mean rate over the last period and `tension_n` the load cell's sample, if
     /// any (kept for this step's [`Protection::bounds`]).
     // Out of line: an unprotected step only tests the Option (scripts/bench-target, flight
-    // config without protection: mission median/worst 1043/1083 inlined, 1013/1048 out of line).
+    // config without protection, before main's budget round: mission median/worst 1043/1083
+    // inlined, 1013/1048 out of line).
     #[inline(never)]
     pub(crate) fn advance(
         &mut self,
