@@ -256,6 +256,7 @@ impl<T: Real> Controller<T> {
             alpha_rad: x.alpha_rad,
             alpha_rate_radps: x.alpha_rate_radps,
             orbit_rate_radps: x.orbit_rate_radps,
+            orbit: reference.orbit,
             ref_angle_rad: reference.angle.angle_rad,
             ref_slope_rad_per_m: reference.angle.slope_rad_per_m,
             ref_curvature_rad_per_m2: reference.angle.curvature_rad_per_m2,

@@ -255,6 +255,7 @@ impl<T: Real> Sequencer<T> {
             angle: band.eval(length_m),
             time_rate_radps: T::ZERO,
             slewing: false,
+            orbit: None,
         }
     }
 

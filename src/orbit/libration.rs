@@ -86,6 +86,14 @@ pub struct Libration<T> {
 }
 
 impl<T: Real> Libration<T> {
+    /// No libration (P ≡ 0), at no eccentricity in particular.
+    pub const NONE: Self = Self {
+        eccentricity: T::ZERO,
+        sine_rad: [T::ZERO; MAX_HARMONICS],
+        harmonics: 0,
+        residual: 0.0,
+    };
+
     /// Solves for the periodic libration at eccentricity `e` (f64 arithmetic, bounded work:
     /// ≤ 40e + 1 continuation steps of ≤ 30 Newton iterations on a 24 × 24 system).
     ///
@@ -128,6 +136,11 @@ impl<T: Real> Libration<T> {
     /// for sin kθ, cos kθ.
     pub fn eval(&self, true_anomaly_rad: T) -> LibrationPoint<T> {
         let (s1, c1) = true_anomaly_rad.sin_cos();
+        self.eval_sin_cos(s1, c1)
+    }
+
+    /// [`Libration::eval`] from sinθ and cosθ.
+    pub fn eval_sin_cos(&self, s1: T, c1: T) -> LibrationPoint<T> {
         let (mut s, mut c) = (s1, c1);
         let mut p = LibrationPoint {
             angle_rad: T::ZERO,
