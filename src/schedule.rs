@@ -337,36 +337,68 @@ pub fn compose<T: Real>(
         a.curvature_rad_per_m2,
         base.time_rate_radps,
     );
-    let (s2, c2) = (f(2.0) * a.angle_rad).sin_cos();
-    let (w, w2, w3) = (o.rate_radps, o.rate_radps * o.rate_radps, o.accel_radps2);
+    let wt = Weight::at(a.angle_rad);
+    let (w, w1, w2, w3) = (wt.value, wt.first, wt.second, wt.third);
+    let (rate, rate2, accel) = (o.rate_radps, o.rate_radps * o.rate_radps, o.accel_radps2);
     // P and its time derivatives at fixed l: θ̇ P′, θ̇² P″ + θ̈ P′, θ̇³ P‴ + 3θ̇θ̈ P″ + θ⃛ P′.
     let p0 = lib.angle_rad;
-    let p1 = w * lib.slope;
-    let p2 = w2 * lib.curvature + w3 * lib.slope;
-    let p3 = w2 * w * lib.third + f(3.0) * w * w3 * lib.curvature + o.jerk_radps3 * lib.slope;
-    let k = T::ONE - f(2.0) * s2 * p0;
+    let p1 = rate * lib.slope;
+    let p2 = rate2 * lib.curvature + accel * lib.slope;
+    let p3 = rate2 * rate * lib.third
+        + f(3.0) * rate * accel * lib.curvature
+        + o.jerk_radps3 * lib.slope;
+    // ∂α_ref/∂α_r = 1 + w′P.
+    let k = T::ONE + w1 * p0;
     let rs2 = rs * rs;
     Reference {
         angle: RefAngle {
-            angle_rad: a.angle_rad + c2 * p0,
+            angle_rad: a.angle_rad + w * p0,
             slope_rad_per_m: pr * k,
-            curvature_rad_per_m2: qr * k - f(4.0) * c2 * p0 * pr * pr,
+            curvature_rad_per_m2: qr * k + w2 * p0 * pr * pr,
         },
-        time_rate_radps: rs * k + c2 * p1,
+        time_rate_radps: rs * k + w * p1,
         slewing: base.slewing,
         orbit: Some(OrbitForcing {
             gradient_per_s2: f(1.5) * o.gravity_gradient_per_s2,
             gradient_rate_per_s3: f(1.5) * o.gravity_gradient_rate_per_s3,
             orbit_accel_radps2: o.accel_radps2,
             orbit_jerk_radps3: o.jerk_radps3,
-            ref_time_accel_radps2: c2 * p2 - f(4.0) * (c2 * rs2 * p0 + s2 * rs * p1),
-            ref_time_jerk_radps3: c2 * p3 + f(8.0) * s2 * rs2 * rs * p0
-                - f(12.0) * c2 * rs2 * p1
-                - f(6.0) * s2 * rs * p2,
-            ref_slope_rate_rad_per_m_s: -f(2.0) * pr * (f(2.0) * c2 * rs * p0 + s2 * p1),
+            ref_time_accel_radps2: w2 * rs2 * p0 + f(2.0) * w1 * rs * p1 + w * p2,
+            ref_time_jerk_radps3: w3 * rs2 * rs * p0
+                + f(3.0) * (w2 * rs2 * p1 + w1 * rs * p2)
+                + w * p3,
+            ref_slope_rate_rad_per_m_s: pr * (w2 * rs * p0 + w1 * p1),
             ref_time_accel_slope_rad_per_m_s2: pr
-                * (f(8.0) * (s2 * rs2 * p0 - c2 * rs * p1) - f(2.0) * s2 * p2),
+                * (w3 * rs2 * p0 + f(2.0) * w2 * rs * p1 + w1 * p2),
         }),
+    }
+}
+
+/// The libration's weight w(α_r) = cos 2α_r and its first three derivatives with respect to
+/// α_r (docs/equations.md §13.2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Weight<T> {
+    /// w.
+    pub value: T,
+    /// dw/dα_r, 1/rad.
+    pub first: T,
+    /// d²w/dα_r², 1/rad².
+    pub second: T,
+    /// d³w/dα_r³, 1/rad³.
+    pub third: T,
+}
+
+impl<T: Real> Weight<T> {
+    /// w = cos 2α_r at α_r (rad): 1 at the keeps, 0 on the −45° plateau.
+    pub fn at(ref_angle_rad: T) -> Self {
+        let f = T::from_f64;
+        let (s2, c2) = (f(2.0) * ref_angle_rad).sin_cos();
+        Self {
+            value: c2,
+            first: -f(2.0) * s2,
+            second: -f(4.0) * c2,
+            third: f(8.0) * s2,
+        }
     }
 }
 
