@@ -246,7 +246,9 @@ impl<T: Real> Controller<T> {
             };
         self.length.sensed(x.length_m);
 
-        let reference = self.sequencer.reference(tick, x.length_m);
+        let reference = self
+            .sequencer
+            .reference_at(tick, x.length_m, x.true_anomaly_rad);
         if self.health.health() == Health::SafeHold {
             if !self.health.recovered(&self.cfg.monitor) {
                 return self.hold(tick, Some(tick), reference.angle.angle_rad, None, flags);
