@@ -2,6 +2,7 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod eccentric;
 pub mod elastic;
 pub mod faults;
 pub mod history;
