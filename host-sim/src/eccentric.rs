@@ -264,8 +264,8 @@ fn draw<DB: DrawingBackend>(
     rows: &[KeepRow],
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     root.fill(&WHITE)?;
-    // Floor the log axis at 1 mm (an error of 0 would have no place on it).
-    let floor = 1e-3;
+    // Floor the log axis at 10 µm (an error of 0 would have no place on it).
+    let floor = 1e-5;
     let pts = |f: fn(&KeepRow) -> f64| -> Vec<(f64, f64)> {
         rows.iter()
             .filter(|r| f(r).is_finite())
