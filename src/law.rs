@@ -21,7 +21,7 @@
 //!
 //! taking the physical root y = 2C/(b + √(b² − 4pC)), the one that tends to C/b as p → 0.
 //!
-//! **Eccentric orbits** (docs/equations.md §13). With [`LawInput::orbit`] set, n is θ̇, the
+//! **Eccentric orbits** (docs/equations.md §14). With [`LawInput::orbit`] set, n is θ̇, the
 //! gravity-gradient factor 1.5n² becomes 1.5μ/R³, and the numerator also takes Eq. 5b's θ̈ and
 //! the reference's explicit time acceleration ∂²α_r/∂t² (the forced libration it follows):
 //!
@@ -91,8 +91,8 @@ impl<T: Real> Blend<T> {
     }
 }
 
-/// The eccentric-orbit terms of Eqs. 27 and 30 at one instant (docs/equations.md §13.3): the
-/// orbit's (§0) and those of a reference that moves with θ (§13.2).
+/// The eccentric-orbit terms of Eqs. 27 and 30 at one instant (docs/equations.md §14.3): the
+/// orbit's (§0) and those of a reference that moves with θ (§14.2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OrbitForcing<T> {
     /// 1.5 μ/R³, 1/s² (1.5 n² on a circular orbit).
@@ -124,7 +124,7 @@ pub struct LawInput<T> {
     pub alpha_rate_radps: T,
     /// Orbit rate n (θ̇ on an eccentric orbit), rad/s.
     pub orbit_rate_radps: T,
-    /// The eccentric-orbit terms (docs/equations.md §13); `None` on a circular orbit, where the
+    /// The eccentric-orbit terms (docs/equations.md §14); `None` on a circular orbit, where the
     /// law is the paper's, bit for bit.
     pub orbit: Option<OrbitForcing<T>>,
     /// α_r, rad.
@@ -213,7 +213,7 @@ pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
     // sin(2δ + 2α_r) = sin 2α.
     let (sin2a, cos2a) = (two * x.alpha_rad).sin_cos();
     // The restoring terms of Eq. 5b that the numerator cancels: 1.5n² sin 2α, and on an
-    // eccentric orbit 1.5(μ/R³) sin 2α + θ̈ + ∂²α_r/∂t² (docs/equations.md §13.3).
+    // eccentric orbit 1.5(μ/R³) sin 2α + θ̈ + ∂²α_r/∂t² (docs/equations.md §14.3).
     let (gradient, gravity) = match &x.orbit {
         None => {
             let gradient = three_halves * n * n;
@@ -268,7 +268,7 @@ pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
 }
 
 /// Eq. 27 evaluated explicitly for a given δ̇ (rad/s), in the paper's form (with the
-/// eccentric-orbit terms of docs/equations.md §13.3 when [`LawInput::orbit`] is set):
+/// eccentric-orbit terms of docs/equations.md §14.3 when [`LawInput::orbit`] is set):
 ///
 /// ```text
 ///   l̇ = [k1 δ̇ + k2 δ − 1.5 n² sin(2δ + 2α_r)] / (n + δ̇) · l/(2 + μ3),   δ = α − α_r.
@@ -344,7 +344,7 @@ pub fn acceleration<T: Real>(x: &LawInput<T>, s: &LawOutput<T>) -> Result<T, Law
     // δ̈ without its p ÿ part: α̈ − q y² (and on an eccentric orbit − 2 (∂²α_r/∂l∂t) y − ∂²α_r/∂t²).
     let mut delta_accel = alpha_accel - x.ref_curvature_rad_per_m2 * y * y;
     if let Some(o) = &x.orbit {
-        // docs/equations.md §13.5: Eq. 5b's θ̈ in α̈; Ṅ's −d(1.5μ/R³)/dt sin 2α − θ⃛ − d(∂²α_r/∂t²)/dt;
+        // docs/equations.md §14.5: Eq. 5b's θ̈ in α̈; Ṅ's −d(1.5μ/R³)/dt sin 2α − θ⃛ − d(∂²α_r/∂t²)/dt;
         // Ḋ's θ̈ (D = θ̇ + δ̇), which enters u̇ as −(N/D) θ̈.
         delta_accel = delta_accel
             - o.orbit_accel_radps2
@@ -583,7 +583,7 @@ mod tests {
 
     #[test]
     fn eccentric_acceleration_is_the_time_derivative_of_the_command() {
-        // Eq. 30 on an eccentric orbit (docs/equations.md §13.5), on the band and in the slew:
+        // Eq. 30 on an eccentric orbit (docs/equations.md §14.5), on the band and in the slew:
         // ÿ against a central difference of the command along the motion.
         for slewing in [false, true] {
             let x0 = eccentric_state(0.0, slewing);
@@ -654,6 +654,30 @@ mod tests {
             }
             assert!(fought > 0.5, "e = {e}: {fought} m/s");
         }
+    }
+
+    #[test]
+    fn an_unknown_true_anomaly_is_a_fault_not_a_number() {
+        // θ not finite on an eccentric orbit: the reference carries NaN orbit terms and the law
+        // faults (the controller's safe action), whatever the rest of the state.
+        use crate::schedule::{LibratingReference, Reference};
+        let base = Reference {
+            angle: crate::schedule::RefAngle {
+                angle_rad: -0.55,
+                slope_rad_per_m: 6.0e-5,
+                curvature_rad_per_m2: 3.0e-9,
+            },
+            time_rate_radps: 0.0,
+            slewing: false,
+            orbit: None,
+        };
+        let r = LibratingReference::without_anomaly(base);
+        assert_eq!(r.angle, base.angle);
+        let x = LawInput {
+            orbit: r.orbit,
+            ..base_input()
+        };
+        assert_eq!(solve(&x), Err(LawFault::NotFinite));
     }
 
     #[test]

@@ -260,7 +260,7 @@ pub struct Reference<T> {
     /// `true` while the slew is still below the schedule.
     pub slewing: bool,
     /// On an eccentric orbit, the orbit's terms and the reference's higher time derivatives
-    /// that the law needs ([`LibratingReference`], docs/equations.md §13); `None` on a
+    /// that the law needs ([`LibratingReference`], docs/equations.md §14); `None` on a
     /// circular orbit.
     pub orbit: Option<OrbitForcing<T>>,
 }
@@ -274,7 +274,7 @@ impl<T: Real> SlewedSchedule<T> {
     }
 }
 
-/// The reference on an eccentric orbit (docs/equations.md §13.2): the schedule's α_r(l) (or the
+/// The reference on an eccentric orbit (docs/equations.md §14.2): the schedule's α_r(l) (or the
 /// slew's α_r(t)) plus the forced periodic libration P(θ) of [`Libration`], weighted by
 /// cos 2α_r,
 ///
@@ -285,7 +285,7 @@ impl<T: Real> SlewedSchedule<T> {
 /// so that it is P itself at the keeps (α_r → 0: keeping a length does not fight the orbit's
 /// forcing) and α_r itself on the −45° deployment plateau (where the reel holds α_r exactly,
 /// inside the Eq. 13 extent), and in between the rate the reference asks for keeps the sign of
-/// its stage all orbit long (to first order in e, for e ≤ 0.6: §13.2).
+/// its stage all orbit long (to first order in e, for e ≤ 0.6: §14.2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LibratingReference<T> {
     orbit: PreparedOrbit<T>,
@@ -313,8 +313,28 @@ impl<T: Real> LibratingReference<T> {
         &self.libration
     }
 
+    /// The reference when θ is not finite: the schedule's α_r with every orbit term NaN, so
+    /// that the law cannot run on it ([`crate::law::LawFault::NotFinite`], the controller's
+    /// safe action) while α_r is still reported (docs/equations.md §14.6).
+    pub fn without_anomaly(base: Reference<T>) -> Reference<T> {
+        let nan = T::from_f64(f64::NAN);
+        Reference {
+            orbit: Some(OrbitForcing {
+                gradient_per_s2: nan,
+                gradient_rate_per_s3: nan,
+                orbit_accel_radps2: nan,
+                orbit_jerk_radps3: nan,
+                ref_time_accel_radps2: nan,
+                ref_time_jerk_radps3: nan,
+                ref_slope_rate_rad_per_m_s: nan,
+                ref_time_accel_slope_rad_per_m_s2: nan,
+            }),
+            ..base
+        }
+    }
+
     /// The reference at true anomaly θ (rad) from the circular one `base` (α_r, ∂α_r/∂l,
-    /// ∂²α_r/∂l², ∂α_r/∂t): every partial derivative the law needs (§13.2; it assumes, as both
+    /// ∂²α_r/∂l², ∂α_r/∂t): every partial derivative the law needs (§14.2; it assumes, as both
     /// schedules give, that ∂α_r/∂l does not depend on t nor ∂α_r/∂t on l).
     pub fn eval(&self, base: Reference<T>, true_anomaly_rad: T) -> Reference<T> {
         let (sin_theta, cos_theta) = true_anomaly_rad.sin_cos();
@@ -324,7 +344,7 @@ impl<T: Real> LibratingReference<T> {
     }
 }
 
-/// α_ref = α_r + cos(2α_r) P and its partial derivatives (docs/equations.md §13.2).
+/// α_ref = α_r + cos(2α_r) P and its partial derivatives (docs/equations.md §14.2).
 pub fn compose<T: Real>(
     base: Reference<T>,
     o: &OrbitAt<T>,
@@ -375,7 +395,7 @@ pub fn compose<T: Real>(
 }
 
 /// The libration's weight w(α_r) = cos 2α_r and its first three derivatives with respect to
-/// α_r (docs/equations.md §13.2).
+/// α_r (docs/equations.md §14.2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Weight<T> {
     /// w.

@@ -92,7 +92,7 @@ pub(super) struct Sequencer<T> {
     stage1_band: PreparedBand<T>,
     /// The Eq. 35 schedule of stage 2, prepared.
     stage2_band: PreparedBand<T>,
-    /// On an eccentric orbit, the forced libration the reference adds (docs/equations.md §13).
+    /// On an eccentric orbit, the forced libration the reference adds (docs/equations.md §14).
     librating: Option<LibratingReference<T>>,
     /// c of the stage-1 and stage-2 blends, 1/s.
     decay_rate_per_s: [T; 2],
@@ -263,13 +263,15 @@ impl<T: Real> Sequencer<T> {
     }
 
     /// [`Sequencer::reference`] at true anomaly θ (rad): on an eccentric orbit, with the forced
-    /// libration and the orbit's terms (docs/equations.md §13); on a circular one, the same.
+    /// libration and the orbit's terms (docs/equations.md §14), and with NaN orbit terms when θ
+    /// is not finite (the law then faults: the safe action); on a circular one, the same.
     #[inline(always)]
     pub(super) fn reference_at(&self, tick: u32, length_m: T, true_anomaly_rad: T) -> Reference<T> {
         let base = self.reference(tick, length_m);
         match &self.librating {
             None => base,
-            Some(r) => r.eval(base, true_anomaly_rad),
+            Some(r) if true_anomaly_rad.is_finite() => r.eval(base, true_anomaly_rad),
+            Some(_) => LibratingReference::without_anomaly(base),
         }
     }
 
