@@ -1,5 +1,5 @@
 //! The forced periodic libration of a constant-length tether on an eccentric orbit
-//! (docs/equations.md §13).
+//! (docs/equations.md §14).
 //!
 //! With the true anomaly θ as the independent variable (′ = d/dθ), a constant length and β = 0,
 //! Eq. 5b becomes the classic pitch equation of a dumbbell on an elliptic orbit:
@@ -23,7 +23,7 @@ pub const MAX_HARMONICS: usize = 24;
 
 /// Largest eccentricity for which [`Libration::new`] looks for the periodic solution. Beyond it
 /// the solution's harmonics decay too slowly for [`MAX_HARMONICS`] to meet
-/// [`RESIDUAL_TOLERANCE`] (docs/equations.md §13.2).
+/// [`RESIDUAL_TOLERANCE`] (docs/equations.md §14.2).
 pub const MAX_ECCENTRICITY: f64 = 0.35;
 
 /// The largest pitch-equation residual accepted at the check points (between the collocation
@@ -34,9 +34,11 @@ pub const RESIDUAL_TOLERANCE: f64 = 1e-9;
 pub const NEGLIGIBLE_COEFFICIENT_RAD: f64 = 1e-11;
 
 /// Newton iterations per continuation step, at most.
+#[cfg(not(all(feature = "firmware", target_os = "none")))]
 const MAX_NEWTON_ITERATIONS: u32 = 30;
 
 /// Continuation steps in e per unit eccentricity (at least one step).
+#[cfg(not(all(feature = "firmware", target_os = "none")))]
 const STEPS_PER_UNIT_ECCENTRICITY: f64 = 40.0;
 
 /// Why no periodic libration was found.
@@ -47,6 +49,9 @@ pub enum LibrationError {
     Eccentricity,
     /// Newton's method did not converge, or the solution misses [`RESIDUAL_TOLERANCE`].
     NotConverged,
+    /// The flight firmware's build leaves the solver out (docs/equations.md §14.2: its flash
+    /// and stack budgets); it flies P ≡ 0.
+    NotInThisBuild,
 }
 
 impl core::fmt::Display for LibrationError {
@@ -57,6 +62,7 @@ impl core::fmt::Display for LibrationError {
                 "the eccentricity must be in [0, {MAX_ECCENTRICITY}] for the periodic libration"
             ),
             Self::NotConverged => write!(f, "no periodic libration found for this eccentricity"),
+            Self::NotInThisBuild => write!(f, "the periodic libration is not in this build"),
         }
     }
 }
@@ -104,6 +110,18 @@ impl<T: Real> Libration<T> {
         if !(e.is_finite() && (0.0..=MAX_ECCENTRICITY).contains(&e)) {
             return Err(LibrationError::Eccentricity);
         }
+        Self::solved(eccentricity, e)
+    }
+
+    /// The flight firmware's build: no solver (see [`LibrationError::NotInThisBuild`]).
+    #[cfg(all(feature = "firmware", target_os = "none"))]
+    fn solved(_eccentricity: T, _e: f64) -> Result<Self, LibrationError> {
+        Err(LibrationError::NotInThisBuild)
+    }
+
+    /// [`Libration::new`] once `e` is checked.
+    #[cfg(not(all(feature = "firmware", target_os = "none")))]
+    fn solved(eccentricity: T, e: f64) -> Result<Self, LibrationError> {
         let (b, residual) = solve_f64(e)?;
         let mut harmonics = MAX_HARMONICS;
         while harmonics > 0 && b[harmonics - 1].abs() < NEGLIGIBLE_COEFFICIENT_RAD {
@@ -163,6 +181,7 @@ impl<T: Real> Libration<T> {
     }
 }
 
+#[cfg(not(all(feature = "firmware", target_os = "none")))]
 /// The pitch equation's residual (1 + e cosθ)P″ − 2e sinθ (P′ + 1) + 1.5 sin 2P at θ.
 pub fn residual_at(e: f64, b: &[f64], theta: f64) -> f64 {
     let (mut p, mut p1, mut p2) = (0.0, 0.0, 0.0);
@@ -180,6 +199,7 @@ pub fn residual_at(e: f64, b: &[f64], theta: f64) -> f64 {
 /// Collocation on θ_j = πj/(N + 1), j = 1 … N (the solution is odd: sin kθ vanishes at 0 and
 /// π), continued from e = 0 in equal steps, Newton at each step. Returns b and the largest
 /// residual on a check grid between the collocation points.
+#[cfg(not(all(feature = "firmware", target_os = "none")))]
 fn solve_f64(e: f64) -> Result<([f64; MAX_HARMONICS], f64), LibrationError> {
     const N: usize = MAX_HARMONICS;
     let mut b = [0.0; N];
@@ -246,6 +266,7 @@ fn solve_f64(e: f64) -> Result<([f64; MAX_HARMONICS], f64), LibrationError> {
     }
 }
 
+#[cfg(not(all(feature = "firmware", target_os = "none")))]
 /// Gaussian elimination with partial pivoting; `None` if the matrix is singular.
 fn gauss_solve<const N: usize>(mut a: [[f64; N]; N], mut r: [f64; N]) -> Option<[f64; N]> {
     for col in 0..N {
