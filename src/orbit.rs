@@ -78,7 +78,7 @@ impl<T: Real> Orbit<T> {
 }
 
 /// The orbit's kinematics at one true anomaly, everything an eccentric-orbit step needs
-/// (docs/equations.md §0, §13.4), from one sin_cos of θ.
+/// (docs/equations.md §0, §14.4), from one sin_cos of θ.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OrbitAt<T> {
     /// θ̇, rad/s.

@@ -1,9 +1,9 @@
 //! `tss-sim eccentric SCENARIO [--eccentricity E,...] [--set KEY=VALUE]... [--out DIR]`: the
-//! scenario's mission flown at each eccentricity (docs/equations.md §13.6), and how well each
+//! scenario's mission flown at each eccentricity (docs/equations.md §14.6), and how well each
 //! keep holds: `eccentric.csv`, `eccentric.txt` (the table) and the figure
 //! `eccentric_keep_error.{png,svg}` (keep error against e).
 //!
-//! **Keep error** (docs/equations.md §13.6): the largest |l − l_keep| over the last hour of a
+//! **Keep error** (docs/equations.md §14.6): the largest |l − l_keep| over the last hour of a
 //! keep, sampled at the history's interval: for the stage-1 keep the hour before stage 2 starts
 //! (for the paper's mission 7.00–8.00 h, Table 1's stage-1 window), for the stage-2 keep the
 //! last hour of the run. The Table-1 figure of `tss-sim run`'s summary (max |simulated − paper|

@@ -2,10 +2,12 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod compare;
 pub mod eccentric;
 pub mod elastic;
 pub mod faults;
 pub mod history;
+pub mod laws;
 pub mod montecarlo;
 pub mod output;
 pub mod pil;

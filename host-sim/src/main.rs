@@ -6,7 +6,7 @@
 use std::process::ExitCode;
 
 use clap::{CommandFactory, Parser, Subcommand};
-use tss_sim::{analysis, eccentric, montecarlo, run_cmd, scenario, usage};
+use tss_sim::{analysis, compare, eccentric, montecarlo, run_cmd, scenario, usage};
 
 /// Exit code for usage errors (as clap uses for bad arguments).
 const EXIT_USAGE: u8 = 2;
@@ -42,6 +42,9 @@ enum Command {
     Montecarlo(montecarlo::MonteCarloArgs),
     /// Fly the scenario at each eccentricity; write the keep errors (table, CSV, figure).
     Eccentric(eccentric::EccentricArgs),
+    /// Fly several deployment laws (`[controller] law`) on one scenario, and with --runs on the
+    /// same dispersed campaign; write one table (compare.txt, compare.csv) and overlaid figures.
+    Compare(compare::CompareArgs),
     /// Combine the output directories of `montecarlo --shard K/N` into the whole campaign's.
     Merge(montecarlo::MergeArgs),
     /// Print a shell completion script, e.g. `tss-sim completions bash > tss-sim.bash`.
@@ -98,6 +101,7 @@ fn main() -> ExitCode {
         Command::Montecarlo(args) => montecarlo::montecarlo(&args),
         Command::Merge(args) => montecarlo::merge(&args),
         Command::Eccentric(args) => eccentric::run_eccentric(&args),
+        Command::Compare(args) => compare::compare(&args),
         Command::Completions { shell } => {
             clap_complete::generate(
                 shell,

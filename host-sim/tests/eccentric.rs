@@ -1,4 +1,4 @@
-//! Station keeping on eccentric orbits (issue 20 §1, docs/equations.md §13): the paper's mission
+//! Station keeping on eccentric orbits (issue 20 §1, docs/equations.md §14): the paper's mission
 //! flown by the flight core (f32) on the rigid plant, with the librating reference. Before it
 //! the law fought the orbit's forcing with the reel: at e = 0.1 (a = 7 800 km) the 30 km keep
 //! erred by 1 711.8 m (the summary's Table-1 figure), at e = 0.3 (a = 10 000 km) by 4 762 m.
@@ -36,7 +36,7 @@ fn at_e_0_1_both_keeps_hold_within_a_metre_and_the_mission_completes() {
         r.completed && (r.final_length_m - 2000.0).abs() < 0.01,
         "{r:?}"
     );
-    // Taut once the paper's start-up transient is over (docs/equations.md §13.6: it dips to
+    // Taut once the paper's start-up transient is over (docs/equations.md §14.6: it dips to
     // −1.0e-4 N at l ≈ 25 m in the first 0.33 h, as it nearly does on the circular orbit).
     assert!(r.last_slack_s.is_nan() || r.last_slack_s < 1800.0, "{r:?}");
 }
