@@ -34,11 +34,11 @@ pub const RESIDUAL_TOLERANCE: f64 = 1e-9;
 pub const NEGLIGIBLE_COEFFICIENT_RAD: f64 = 1e-11;
 
 /// Newton iterations per continuation step, at most.
-#[cfg(not(all(feature = "firmware", target_os = "none")))]
+#[cfg(not(target_os = "none"))]
 const MAX_NEWTON_ITERATIONS: u32 = 30;
 
 /// Continuation steps in e per unit eccentricity (at least one step).
-#[cfg(not(all(feature = "firmware", target_os = "none")))]
+#[cfg(not(target_os = "none"))]
 const STEPS_PER_UNIT_ECCENTRICITY: f64 = 40.0;
 
 /// Why no periodic libration was found.
@@ -49,8 +49,8 @@ pub enum LibrationError {
     Eccentricity,
     /// Newton's method did not converge, or the solution misses [`RESIDUAL_TOLERANCE`].
     NotConverged,
-    /// The flight firmware's build leaves the solver out (docs/equations.md §14.2: its flash
-    /// and stack budgets); it flies P ≡ 0.
+    /// A bare-metal build (`target_os = "none"`: the firmwares) leaves the solver out
+    /// (docs/equations.md §14.2: their flash and stack budgets); it flies P ≡ 0.
     NotInThisBuild,
 }
 
@@ -113,14 +113,14 @@ impl<T: Real> Libration<T> {
         Self::solved(eccentricity, e)
     }
 
-    /// The flight firmware's build: no solver (see [`LibrationError::NotInThisBuild`]).
-    #[cfg(all(feature = "firmware", target_os = "none"))]
+    /// A bare-metal build: no solver (see [`LibrationError::NotInThisBuild`]).
+    #[cfg(target_os = "none")]
     fn solved(_eccentricity: T, _e: f64) -> Result<Self, LibrationError> {
         Err(LibrationError::NotInThisBuild)
     }
 
     /// [`Libration::new`] once `e` is checked.
-    #[cfg(not(all(feature = "firmware", target_os = "none")))]
+    #[cfg(not(target_os = "none"))]
     fn solved(eccentricity: T, e: f64) -> Result<Self, LibrationError> {
         let (b, residual) = solve_f64(e)?;
         let mut harmonics = MAX_HARMONICS;
@@ -181,7 +181,7 @@ impl<T: Real> Libration<T> {
     }
 }
 
-#[cfg(not(all(feature = "firmware", target_os = "none")))]
+#[cfg(not(target_os = "none"))]
 /// The pitch equation's residual (1 + e cosθ)P″ − 2e sinθ (P′ + 1) + 1.5 sin 2P at θ.
 pub fn residual_at(e: f64, b: &[f64], theta: f64) -> f64 {
     let (mut p, mut p1, mut p2) = (0.0, 0.0, 0.0);
@@ -199,7 +199,7 @@ pub fn residual_at(e: f64, b: &[f64], theta: f64) -> f64 {
 /// Collocation on θ_j = πj/(N + 1), j = 1 … N (the solution is odd: sin kθ vanishes at 0 and
 /// π), continued from e = 0 in equal steps, Newton at each step. Returns b and the largest
 /// residual on a check grid between the collocation points.
-#[cfg(not(all(feature = "firmware", target_os = "none")))]
+#[cfg(not(target_os = "none"))]
 fn solve_f64(e: f64) -> Result<([f64; MAX_HARMONICS], f64), LibrationError> {
     const N: usize = MAX_HARMONICS;
     let mut b = [0.0; N];
@@ -266,7 +266,7 @@ fn solve_f64(e: f64) -> Result<([f64; MAX_HARMONICS], f64), LibrationError> {
     }
 }
 
-#[cfg(not(all(feature = "firmware", target_os = "none")))]
+#[cfg(not(target_os = "none"))]
 /// Gaussian elimination with partial pivoting; `None` if the matrix is singular.
 fn gauss_solve<const N: usize>(mut a: [[f64; N]; N], mut r: [f64; N]) -> Option<[f64; N]> {
     for col in 0..N {
