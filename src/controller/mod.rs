@@ -42,7 +42,7 @@
 //! [`RateSource::Sensor`] (the paper's idealisation, [`Config::paper`], Table 1) flies the law
 //! on the sensed α and α̇. [`RateSource::Estimator`] ([`Config::flight`], the firmware's) flies
 //! it on α̂ and α̇̂ of the onboard EKF ([`crate::estimator`]) from α alone, stepped once per
-//! period inside the step (docs/equations.md §14): the estimate is carried over the period
+//! period inside the step (docs/equations.md §13): the estimate is carried over the period
 //! under the drive the last step commanded (or the encoder's measured rate), then updated with
 //! this period's α. For the fault logic:
 //!
@@ -331,7 +331,9 @@ impl<T: Real> Controller<T> {
         };
         self.length.sensed(x.length_m);
 
-        let reference = self.sequencer.reference(tick, x.length_m);
+        let reference = self
+            .sequencer
+            .reference_at(tick, x.length_m, x.true_anomaly_rad);
         if self.health.health() == Health::SafeHold {
             if !self.health.recovered(&self.cfg.monitor) {
                 return self.hold(tick, Some(tick), reference.angle.angle_rad, None, flags);
@@ -348,6 +350,7 @@ impl<T: Real> Controller<T> {
             alpha_rad,
             alpha_rate_radps,
             orbit_rate_radps: x.orbit_rate_radps,
+            orbit: reference.orbit,
             ref_angle_rad: reference.angle.angle_rad,
             ref_slope_rad_per_m: reference.angle.slope_rad_per_m,
             ref_curvature_rad_per_m2: reference.angle.curvature_rad_per_m2,
