@@ -11,6 +11,10 @@
 
 use proptest::prelude::*;
 use std::f64::consts::TAU;
+
+/// The drive's faults in the outer controller's health (`Controller::step_with_drive`).
+#[path = "reel_drive/health.rs"]
+mod health;
 use tss_reel::reel_drive::{
     Brake, DriveConfig, DriveFault, DriveInput, DriveOutput, DriveRule, RateCommand, SpeedLoop,
 };
@@ -404,7 +408,7 @@ fn a_counter_that_lost_counts_for_good_trips_the_drive() {
             assert!(!out.brake.brake_released() && !out.brake.motor_enabled());
             assert_eq!(
                 out.faults.outer_reaction(),
-                tss_reel::reel_drive::OuterReaction::LengthSampleMissing
+                tss_reel::reel_drive::OuterReaction::Degrade
             );
         }
     }

@@ -35,6 +35,7 @@
 //! accumulates time in floating point.
 
 mod clock;
+mod drive;
 mod events;
 mod health;
 mod output;

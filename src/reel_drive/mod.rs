@@ -166,18 +166,25 @@ pub enum DriveFault {
     Actuator,
 }
 
-/// What the outer controller should make of a drive fault.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// What the outer controller makes of a drive fault (applied by
+/// [`Controller::step_with_drive`](crate::controller::Controller::step_with_drive)). Ordered:
+/// the strongest reaction of a period's faults wins.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum OuterReaction {
-    /// Telemetry only: the drive copes (the outer envelope and length monitor cover it).
+    /// Telemetry only: the drive copes (the fault is the caller's own, and its safe action is
+    /// already taken by the drive).
     Report,
-    /// The reel's length (from this encoder) or its motion cannot be trusted this period: the
-    /// caller steps the outer controller with
-    /// [`Controller::step_missing`](crate::controller::Controller::step_missing), so it coasts
-    /// (`Health::Degraded`, `Fault::Sensor(Sensor::Missing)`) and, if the fault persists past
-    /// `coast_ticks`, goes to `Health::SafeHold`, whose zero command keeps the brake engaged.
-    LengthSampleMissing,
+    /// The period's reel data (the encoder's length, the drum's motion) cannot be trusted, or
+    /// the drum cannot follow the command: the period is a missing sample for the outer
+    /// controller, which coasts (`Health::Degraded`, `Fault::Sensor(Sensor::Missing)`) and, if
+    /// the fault persists past `coast_ticks` (its leaky counter), goes to `Health::SafeHold`.
+    Degrade,
+    /// The drive tripped (motor off, brake on): the reel cannot move, so the law's command
+    /// means nothing. `Health::SafeHold` at once (its zero command keeps the brake engaged
+    /// once the trip is cleared), left only after `recovery_ticks` valid periods in a row
+    /// without a trip.
+    SafeHold,
 }
 
 impl DriveFault {
@@ -193,23 +200,23 @@ impl DriveFault {
         Self::Actuator,
     ];
 
-    /// The mapping onto the outer fault logic:
+    /// The mapping onto the outer fault logic (docs/hazards.md for the hazards):
     ///
-    /// | fault | reaction | outer hazard |
-    /// |---|---|---|
-    /// | `EncoderJump`, `EncoderMissing` | [`OuterReaction::LengthSampleMissing`] | HZ-1 / HZ-6 |
-    /// | `MotorStall`, `Actuator` | [`OuterReaction::LengthSampleMissing`] (the drive tripped) | HZ-7 |
-    /// | `DutySaturated` | [`OuterReaction::Report`] | HZ-7 |
-    /// | `TensionOutOfRange` | [`OuterReaction::Report`] | HZ-10 |
-    /// | `Tick`, `CommandInvalid` | [`OuterReaction::Report`] (the caller's own error) | HZ-12 |
+    /// | fault | reaction | why | hazard |
+    /// |---|---|---|---|
+    /// | `EncoderJump`, `EncoderMissing` | [`OuterReaction::Degrade`] | the length sample comes from this encoder | HZ-1 / HZ-6 |
+    /// | `DutySaturated` | [`OuterReaction::Degrade`] | the drum does not follow the command: coast on the last one, safe hold if it lasts | HZ-7 |
+    /// | `TensionOutOfRange` | [`OuterReaction::Degrade`] | slack, break or overload: the law's model does not hold | HZ-10 |
+    /// | `MotorStall`, `Actuator` | [`OuterReaction::SafeHold`] | the drive tripped: the reel cannot move | HZ-7 |
+    /// | `Tick`, `CommandInvalid` | [`OuterReaction::Report`] | the caller's own error; the drive already holds | HZ-12 |
     pub fn outer_reaction(self) -> OuterReaction {
         match self {
-            Self::EncoderJump | Self::EncoderMissing | Self::MotorStall | Self::Actuator => {
-                OuterReaction::LengthSampleMissing
-            }
-            Self::Tick | Self::DutySaturated | Self::TensionOutOfRange | Self::CommandInvalid => {
-                OuterReaction::Report
-            }
+            Self::MotorStall | Self::Actuator => OuterReaction::SafeHold,
+            Self::EncoderJump
+            | Self::EncoderMissing
+            | Self::DutySaturated
+            | Self::TensionOutOfRange => OuterReaction::Degrade,
+            Self::Tick | Self::CommandInvalid => OuterReaction::Report,
         }
     }
 
@@ -251,14 +258,15 @@ impl DriveFaults {
 
     /// The strongest reaction any fault of the set asks of the outer controller.
     pub fn outer_reaction(self) -> OuterReaction {
-        if self
-            .iter()
-            .any(|f| f.outer_reaction() == OuterReaction::LengthSampleMissing)
-        {
-            OuterReaction::LengthSampleMissing
-        } else {
-            OuterReaction::Report
-        }
+        self.iter()
+            .map(DriveFault::outer_reaction)
+            .max()
+            .unwrap_or(OuterReaction::Report)
+    }
+
+    /// The union of two sets (a period's faults are the union of its ticks').
+    pub fn union(self, other: Self) -> Self {
+        Self(self.0 | other.0)
     }
 }
 
@@ -818,12 +826,19 @@ mod tests {
     fn the_faults_map_onto_the_outer_logic() {
         let mut set = DriveFaults::NONE;
         set.insert(DriveFault::TensionOutOfRange);
-        assert_eq!(set.outer_reaction(), OuterReaction::Report);
+        assert_eq!(DriveFaults::NONE.outer_reaction(), OuterReaction::Report);
+        assert_eq!(set.outer_reaction(), OuterReaction::Degrade);
         set.insert(DriveFault::EncoderJump);
-        assert_eq!(set.outer_reaction(), OuterReaction::LengthSampleMissing);
+        assert_eq!(set.outer_reaction(), OuterReaction::Degrade);
+        set.insert(DriveFault::MotorStall);
+        assert_eq!(set.outer_reaction(), OuterReaction::SafeHold);
         assert_eq!(
             set.iter().collect::<heapless::Vec<_, 8>>().as_slice(),
-            &[DriveFault::EncoderJump, DriveFault::TensionOutOfRange]
+            &[
+                DriveFault::EncoderJump,
+                DriveFault::MotorStall,
+                DriveFault::TensionOutOfRange
+            ]
         );
     }
 }
