@@ -741,10 +741,11 @@ proptest! {
                         tension_n,
                     });
                     prop_assert!(out.duty.is_finite() && out.duty.abs() <= cfg.duty_limit, "{:?}", out);
+                    let p = drive.torque_parts();
                     for v in [
-                        out.ref_rate_mps, out.ref_accel_mps2, out.speed_mps, out.error_mps,
-                        out.p_nm, out.i_nm, out.ff_inertia_nm, out.ff_tension_nm,
-                        out.ff_friction_nm, out.tension_n, out.torque_nm,
+                        out.ref_rate_mps, out.ref_accel_mps2, out.speed_mps, p.error_mps,
+                        p.p_nm, p.i_nm, p.ff_inertia_nm, p.ff_tension_nm,
+                        p.ff_friction_nm, out.tension_n, out.torque_nm,
                     ] {
                         prop_assert!(v.is_finite(), "{:?}", out);
                     }
