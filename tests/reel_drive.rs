@@ -627,7 +627,7 @@ fn every_invalid_parameter_is_named() {
             c.geometry.encoder_bits = 33
         }),
         ("speed_window_ticks", DriveRule::OutOfRange, |c| {
-            c.speed_window_ticks = 9
+            c.speed_window_ticks = 6
         }),
         ("drum.coulomb_nm", DriveRule::Negative, |c| {
             c.drum.coulomb_nm = -0.1
