@@ -343,6 +343,8 @@ struct Ramp {
     target_mps: f32,
     /// Signed slope toward the target (0 if already there), m/s².
     slope_mps2: f32,
+    /// The slope × tick: the reference's change per tick, m/s.
+    step_mps: f32,
     /// Ticks from `start_tick` until the target is reached (integer time: the reference is the
     /// target from then on, and never passes it before).
     ramp_ticks: u32,
@@ -354,6 +356,7 @@ impl Ramp {
         start_tick: 0,
         target_mps: 0.0,
         slope_mps2: 0.0,
+        step_mps: 0.0,
         ramp_ticks: 0,
     };
 }
@@ -383,6 +386,8 @@ pub struct SpeedLoop {
     odometer: Odometer,
     /// The last command, as received (after sanitising).
     command: RateCommand,
+    /// The command asks for motion: |rate| above the brake's rest speed.
+    command_moving: bool,
     /// The faults every step reports until the next command: [`DriveFault::CommandInvalid`]
     /// after a non-finite one, none otherwise.
     command_faults: DriveFaults,
@@ -424,6 +429,7 @@ impl SpeedLoop {
                 accel_mps2: 0.0,
                 safe_hold: false,
             },
+            command_moving: false,
             command_faults: DriveFaults::NONE,
             ramp: Ramp::REST,
             ramp_from_rest: Ramp::REST,
@@ -503,6 +509,7 @@ impl SpeedLoop {
                 safe_hold: true,
             }
         };
+        self.command_moving = self.command.rate_mps.abs() > self.cfg.brake.rest_speed_mps;
         let (now_mps, _) = self.reference_at(tick);
         self.ramp = self.ramp_toward_command(now_mps, tick);
         self.ramp_from_rest = self.ramp_toward_command(0.0, tick);
@@ -604,10 +611,8 @@ impl SpeedLoop {
                 (0.0, 0.0, 0.0)
             }
         };
-        let limit = self.cfg.duty_limit;
-        let raw_duty = torque_nm * self.derived.per_max_torque;
-        let saturated = raw_duty.abs() > limit;
-        let mut duty = clamp_abs(raw_duty, limit);
+        let (mut duty, saturated) =
+            saturate(torque_nm * self.derived.per_max_torque, self.cfg.duty_limit);
 
         // Saturation held too long (reported), stall (trips). The counters are only touched
         // beyond resetting them when their condition holds (rare).
@@ -715,9 +720,8 @@ impl SpeedLoop {
     /// Entering `Released` starts the ramp from rest at `tick` (the drum was held until now).
     /// At rest means the command, the last reference and the measured speed all ~0.
     fn next_brake(&mut self, tick: u32, gap_ticks: u32, speed_mps: f32, counted: bool) -> Brake {
-        let rest = self.cfg.brake.rest_speed_mps;
         let hold = self.command.safe_hold;
-        let target_moving = self.command.rate_mps.abs() > rest;
+        let target_moving = self.command_moving;
         match self.brake {
             Brake::Tripped(f) => Brake::Tripped(f),
             Brake::Engaged => {
@@ -745,6 +749,7 @@ impl SpeedLoop {
                 }
             }
             Brake::Released { rest_ticks } => {
+                let rest = self.cfg.brake.rest_speed_mps;
                 let at_rest = !target_moving
                     && self.out.ref_rate_mps.abs() <= rest
                     && speed_mps.abs() <= rest;
@@ -779,11 +784,13 @@ impl SpeedLoop {
         // Whole ticks to the target, rounded up (`as` saturates; 0 when already there).
         let ticks = dv.abs() / magnitude * self.cfg.inner_rate_hz as f32;
         let whole = ticks as u32;
+        let slope_mps2 = magnitude.copysign(dv);
         Ramp {
             start_mps,
             start_tick: tick,
             target_mps: target,
-            slope_mps2: magnitude.copysign(dv),
+            slope_mps2,
+            step_mps: slope_mps2 * self.derived.tick_s,
             ramp_ticks: if (whole as f32) < ticks {
                 whole.saturating_add(1)
             } else {
@@ -800,26 +807,30 @@ impl SpeedLoop {
         if age_ticks >= r.ramp_ticks {
             (r.target_mps, 0.0)
         } else {
-            let age_s = age_ticks as f32 * self.derived.tick_s;
-            (r.start_mps + r.slope_mps2 * age_s, r.slope_mps2)
+            (r.start_mps + r.step_mps * age_ticks as f32, r.slope_mps2)
         }
     }
 }
 
-/// `x` limited to [−limit, limit] (limit ≥ 0), by comparisons: `f32::clamp` panics on bad
-/// bounds, and `f32::min`/`max` are library calls (`fminf`/`fmaxf`) on the Cortex-M4F — with
-/// them the step took 420 instructions (median, `examples/bench_speed_loop.rs`), 328 with
-/// this and the reference evaluated once. A NaN `x` gives 0 (no torque).
-fn clamp_abs(x: f32, limit: f32) -> f32 {
+/// `x` limited to [−limit, limit] (limit ≥ 0), and whether it was beyond: by comparisons,
+/// which decide both at once (`f32::clamp` panics on bad bounds, and `f32::min`/`max` are
+/// library calls, `fminf`/`fmaxf`, on the Cortex-M4F: with them the step took 420 instructions,
+/// median, `examples/bench_speed_loop.rs`). A NaN `x` gives 0 (no torque), not saturated.
+fn saturate(x: f32, limit: f32) -> (f32, bool) {
     if x > limit {
-        limit
+        (limit, true)
     } else if x < -limit {
-        -limit
+        (-limit, true)
     } else if x.is_nan() {
-        0.0
+        (0.0, false)
     } else {
-        x
+        (x, false)
     }
+}
+
+/// [`saturate`]'s value.
+fn clamp_abs(x: f32, limit: f32) -> f32 {
+    saturate(x, limit).0
 }
 
 /// A finite `x` limited to [−limit, limit] (limit ≥ 0): [`clamp_abs`] without its NaN check,
