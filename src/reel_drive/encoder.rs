@@ -98,10 +98,7 @@ impl Odometer {
         // Ticks skipped since the last update (rare: an overrun) get the predicted total.
         let skipped = tick.wrapping_sub(self.last_tick).wrapping_sub(1);
         if skipped != 0 && self.accepted.is_some() {
-            for _ in 0..skipped.min(RING as u32) {
-                self.last_tick = self.last_tick.wrapping_add(1);
-                self.totals[self.last_tick as usize % RING] = self.predicted_total();
-            }
+            self.fill_skipped(skipped);
         }
         self.last_tick = tick;
         let result = self.count(tick, raw);
@@ -110,6 +107,17 @@ impl Odometer {
             Err(_) => self.predicted_total(),
         };
         result
+    }
+
+    /// Gives the `skipped` ticks after `last_tick` their predicted totals. Out of line and
+    /// cold: an overrun is rare, and its loop kept inline costs the nominal step registers.
+    #[cold]
+    #[inline(never)]
+    fn fill_skipped(&mut self, skipped: u32) {
+        for _ in 0..skipped.min(RING as u32) {
+            self.last_tick = self.last_tick.wrapping_add(1);
+            self.totals[self.last_tick as usize % RING] = self.predicted_total();
+        }
     }
 
     /// The total at `last_tick` if the drum kept the speed of the window before it: the
@@ -125,9 +133,7 @@ impl Odometer {
     fn count(&mut self, tick: u32, raw: Option<u32>) -> Result<(), CountFault> {
         let raw = raw.ok_or(CountFault::Missing)?;
         let Some(last) = self.accepted else {
-            // The reference reading: the total stays (0 at the first), the speed restarts at 0.
-            self.accepted = Some(Accepted { raw, tick });
-            self.totals = [self.total_counts as u32; RING];
+            self.take_reference(raw, tick);
             return Ok(());
         };
         // The change modulo 2^bits, sign-extended: exact for |change| < 2^(bits−1).
@@ -142,6 +148,15 @@ impl Odometer {
         self.accepted = Some(Accepted { raw, tick });
         self.total_counts = self.total_counts.wrapping_add(i64::from(change));
         Ok(())
+    }
+
+    /// The reference reading: the total stays (0 at the first), the speed restarts at 0. Cold
+    /// (once, and after each trip).
+    #[cold]
+    #[inline(never)]
+    fn take_reference(&mut self, raw: u32, tick: u32) {
+        self.accepted = Some(Accepted { raw, tick });
+        self.totals = [self.total_counts as u32; RING];
     }
 
     /// Forgets the counter's reference: the next reading is taken as the new one, and the
