@@ -56,6 +56,7 @@
 pub mod config;
 pub mod encoder;
 pub mod hal;
+pub mod sim;
 
 pub use config::{
     BrakeConfig, DriveConfig, DriveConfigError, DriveRule, DrumModel, FaultLimits, Geometry,
@@ -262,6 +263,11 @@ impl DriveFaults {
             .map(DriveFault::outer_reaction)
             .max()
             .unwrap_or(OuterReaction::Report)
+    }
+
+    /// The set as bits, one per fault in [`DriveFault::ALL`] order (for telemetry).
+    pub fn bits(self) -> u16 {
+        self.0
     }
 
     /// The union of two sets (a period's faults are the union of its ticks').
