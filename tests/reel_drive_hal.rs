@@ -384,7 +384,7 @@ fn the_drive_over_the_simulated_reel_tracks_ramps_and_stops() {
                 }
             }
         }
-        if period >= 1 && period <= 6 {
+        if (1..=6).contains(&period) {
             assert!((drum.borrow().speed_mps() - rate).abs() < 0.01, "{period}");
         }
     }
