@@ -15,9 +15,12 @@ fn input(tick: u32) -> Input<f32> {
     Input {
         tick,
         length_m,
-        alpha_rad,
-        alpha_rate_radps,
+        reel_rate_mps: None,
+        tension_n: None,
+        alpha_rad: Some(alpha_rad),
+        alpha_rate_radps: Some(alpha_rate_radps),
         orbit_rate_radps: mission::ORBIT_RATE_RADPS,
+        true_anomaly_rad: 0.0,
     }
 }
 
