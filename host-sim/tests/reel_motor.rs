@@ -64,7 +64,7 @@ fn the_flight_speed_loop_tracks_the_paper_deployment_at_1_khz() {
             accel_mps2: s.length_accel_mps2 as f32,
             safe_hold: false,
         };
-        reel.period(cmd, s.tension_n, ticks);
+        let _ = reel.period(cmd, s.tension_n, ticks);
     }
     let f = *reel.figures();
     eprintln!(

@@ -293,14 +293,16 @@ impl FlightDrum {
     }
 
     /// One law period of `ticks` inner ticks under the law's `command`, the tether pulling
-    /// with `tension_n` at the reel. Returns the drum's surface speed at its end, m/s.
+    /// with `tension_n` at the reel. Returns the drum's surface speed at its end, m/s, and the
+    /// period's largest |drum speed − reference| with the brake released, m/s.
     pub fn period(
         &mut self,
         command: tss_reel::reel_drive::RateCommand,
         tension_n: f64,
         ticks: u32,
-    ) -> f64 {
+    ) -> (f64, f64) {
         use tss_reel::reel_drive::DriveInput;
+        let mut period_max_mps: f64 = 0.0;
         let _ = self.speed.set_command(command, self.tick);
         let dt = 1.0 / f64::from(self.speed.config().inner_rate_hz);
         let h = dt / f64::from(self.substeps);
@@ -337,13 +339,14 @@ impl FlightDrum {
                 f.released_ticks += 1;
                 f.sum_sq_error += error * error;
                 f.max_error_mps = f.max_error_mps.max(error.abs());
+                period_max_mps = period_max_mps.max(error.abs());
             }
             self.tick = self.tick.wrapping_add(1);
         }
         let end_error = (self.speed_mps() - f64::from(command.rate_mps)).abs();
         let f = &mut self.figures;
         f.max_period_end_error_mps = f.max_period_end_error_mps.max(end_error);
-        self.speed_mps()
+        (self.speed_mps(), period_max_mps)
     }
 }
 
