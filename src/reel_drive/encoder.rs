@@ -97,7 +97,7 @@ impl Odometer {
     pub fn update(&mut self, tick: u32, raw: Option<u32>) -> Result<(), CountFault> {
         // Ticks skipped since the last update (rare: an overrun) get the predicted total.
         let skipped = tick.wrapping_sub(self.last_tick).wrapping_sub(1);
-        if skipped != 0 && self.accepted.is_some() {
+        if skipped != 0 {
             self.fill_skipped(skipped);
         }
         self.last_tick = tick;
@@ -114,6 +114,10 @@ impl Odometer {
     #[cold]
     #[inline(never)]
     fn fill_skipped(&mut self, skipped: u32) {
+        if self.accepted.is_none() {
+            // No reference yet: the next reading fills the ring.
+            return;
+        }
         for _ in 0..skipped.min(RING as u32) {
             self.last_tick = self.last_tick.wrapping_add(1);
             self.totals[self.last_tick as usize % RING] = self.predicted_total();

