@@ -104,7 +104,7 @@ impl Odometer {
         let result = self.count(tick, raw);
         self.totals[tick as usize % RING] = match result {
             Ok(()) => self.total_counts as u32,
-            Err(_) => self.predicted_total(),
+            Err(_) => self.unread_total(),
         };
         result
     }
@@ -115,12 +115,22 @@ impl Odometer {
     #[inline(never)]
     fn fill_skipped(&mut self, skipped: u32) {
         if self.accepted.is_none() {
-            // No reference yet: the next reading fills the ring.
+            // No reference: every slot already holds the total (see `resync`).
             return;
         }
         for _ in 0..skipped.min(RING as u32) {
             self.last_tick = self.last_tick.wrapping_add(1);
             self.totals[self.last_tick as usize % RING] = self.predicted_total();
+        }
+    }
+
+    /// The total of a tick without an accepted reading: the predicted one, or, without a
+    /// reference to predict from, the total (which every slot then holds, see `resync`).
+    fn unread_total(&self) -> u32 {
+        if self.accepted.is_some() {
+            self.predicted_total()
+        } else {
+            self.total_counts as u32
         }
     }
 
@@ -137,7 +147,9 @@ impl Odometer {
     fn count(&mut self, tick: u32, raw: Option<u32>) -> Result<(), CountFault> {
         let raw = raw.ok_or(CountFault::Missing)?;
         let Some(last) = self.accepted else {
-            self.take_reference(raw, tick);
+            // The reference reading: the total stays (0 at the first). The ring already holds
+            // the total in every slot (see `resync`), so the speed restarts at 0.
+            self.accepted = Some(Accepted { raw, tick });
             return Ok(());
         };
         // The change modulo 2^bits, sign-extended: exact for |change| < 2^(bits−1).
@@ -154,22 +166,21 @@ impl Odometer {
         Ok(())
     }
 
-    /// The reference reading: the total stays (0 at the first), the speed restarts at 0. Cold
-    /// (once, and after each trip).
-    #[cold]
-    #[inline(never)]
-    fn take_reference(&mut self, raw: u32, tick: u32) {
-        self.accepted = Some(Accepted { raw, tick });
-        self.totals = [self.total_counts as u32; RING];
-    }
-
     /// Forgets the counter's reference: the next reading is taken as the new one, and the
     /// total count continues from where it is. For a counter that was lost (an encoder trip):
     /// after a long gap a change of the counter is ambiguous modulo 2^bits, so the travel
     /// during the outage is not counted, and the paid-out length must be re-referenced by the
     /// outer loop's length sensor.
+    ///
+    /// Every slot of the window's ring then holds the total, and keeps holding it until the
+    /// next reading (the reference) is accepted, so that the speed restarts from 0 there; the
+    /// ring is filled here, outside the step, rather than at that reading: the fill is 16
+    /// stores in a loop, 64 instructions, which made the reference reading's step the worst of
+    /// all (208 instructions, exact, `scripts/bench-target` with `TSS_BENCH_EXACT=1`; the
+    /// construction's zeros are the first reference's total).
     pub fn resync(&mut self) {
         self.accepted = None;
+        self.totals = [self.total_counts as u32; RING];
     }
 
     /// Ticks since the last accepted reading at `tick` (`None` before the first).
