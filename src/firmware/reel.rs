@@ -8,9 +8,9 @@
 //! setting, any whole number of ms up to 10, so at least 100 Hz). The main loop wakes on each
 //! tick; every [`OUTER_PERIOD_TICKS`] ticks (1 s, the law's period) it first runs the outer
 //! step ([`super::mission::Mission::step`]) and hands its command to the drive, then, every
-//! tick, the inner step. A foreground loop, not preemption: the outer step (≤ 550
-//! instructions, `scripts/bench-target`) and an inner step (≤ 200 with the driver and drum
-//! model around it well under 1 000) fit in one inner period (25 000 instructions at 25 MHz),
+//! tick, the inner step. A foreground loop, not preemption: the outer step (≤ 925
+//! instructions on the estimator, `scripts/bench-target`) and an inner step (≤ 209, with the
+//! driver and drum model around it well under 1 000) fit in one inner period (25 000 instructions at 25 MHz),
 //! so the inner loop is never late; a tick that is, is an overrun, counted by the clock
 //! ([`super::clock::ControlClock::overruns`]) and logged. (The NUCLEO-G474RE firmware runs the
 //! inner loop in the SysTick exception instead, preempting the outer: the same rates and

@@ -349,13 +349,19 @@ fn masked(message: &str) -> String {
 
 /// The names of the number keys that have no unit: ratios, coefficients and counts (the last
 /// part of the key; `tss-sim scenario keys` shows "-" for them).
-pub const DIMENSIONLESS_NAMES: [&str; 6] = [
+pub const DIMENSIONLESS_NAMES: [&str; 11] = [
     "eccentricity",
     "courant",
     "drag_coefficient",
     "seed",
     "substeps",
     "good_samples_per_bad",
+    // The tension laws' gains (`[controller.rupp]`, `[controller.tracking]`): in units of Ω.
+    "length_gain",
+    "rate_gain",
+    "bias_gain",
+    "schedule_rate",
+    "retrieve_schedule_rate",
 ];
 
 /// The unit in a key's name, by the naming convention (`_m`, `_mps`, `_rad_per_m`, `_nm`, …);
