@@ -57,6 +57,7 @@
 //!   sensed α̇) give way to the gate.
 
 mod clock;
+mod drive;
 mod estimation;
 mod events;
 mod health;
