@@ -8,6 +8,7 @@
 //! different implementations of these traits.
 
 use crate::controller::{Controller, Input, Output};
+use crate::reel_drive::DriveFaults;
 
 /// What kind of failure a sensor or actuator reported.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -153,10 +154,16 @@ pub struct Cycle {
 /// without α, the encoder's rate or the tension, the sample has that field `None` (flying on
 /// the estimator, a period without α is predicted only). There is no α̇ sensor: a controller
 /// that flies on one ([`crate::config::RateSource::Sensor`]) is not flown through this cycle.
+///
+/// `drive` is what the reel's inner speed loop reported over the law period that ended (the
+/// union of its ticks' faults, [`DriveFaults::NONE`] for a drive without one): it reaches the
+/// controller's health through [`Controller::step_with_drive`] (a drive fault degrades the
+/// period or forces a safe hold, see [`crate::reel_drive::OuterReaction`]).
 pub fn control_cycle<L, S, O, R, F>(
     controller: &mut Controller<f32>,
     tick: u32,
     dev: &mut Devices<L, S, O, R, F>,
+    drive: DriveFaults,
 ) -> Cycle
 where
     L: LengthSensor,
@@ -191,9 +198,17 @@ where
                 orbit_rate_radps,
                 true_anomaly_rad,
             };
-            (controller.step(&input), None, reading_error)
+            (
+                controller.step_with_drive(tick, Some(&input), drive),
+                None,
+                reading_error,
+            )
         }
-        Err(kind) => (controller.step_missing(tick), Some(kind), None),
+        Err(kind) => (
+            controller.step_with_drive(tick, None, drive),
+            Some(kind),
+            None,
+        ),
     };
     let reel_error = dev.reel.command(&output).err().map(|e| e.kind());
     Cycle {
@@ -298,14 +313,41 @@ mod tests {
             reel: &mut reel,
             tension: &mut others3,
         };
-        let c0 = control_cycle(&mut ctl, 0, &mut dev);
+        let c0 = control_cycle(&mut ctl, 0, &mut dev, DriveFaults::NONE);
         assert!(c0.sensor_error.is_none() && ctl.output().fault.is_none());
-        let c1 = control_cycle(&mut ctl, 1, &mut dev);
+        let c1 = control_cycle(&mut ctl, 1, &mut dev, DriveFaults::NONE);
         assert_eq!(c1.sensor_error, Some(ErrorKind::Corrupted));
         let o = ctl.output();
         assert_eq!((o.tick, o.fault), (1, Some(Fault::Sensor(Sensor::Missing))));
         assert_eq!(o.health, Health::Degraded);
         assert_eq!(reel.last, Some(o.rate_cmd_mps));
+    }
+
+    #[test]
+    fn a_stalled_drive_reported_to_the_cycle_forces_a_safe_hold() {
+        let mut ctl = flight();
+        let fixed = || Fixed {
+            length_m: 100.0,
+            fail_at: None,
+        };
+        let (mut length, mut swing, mut orbit, mut load) = (fixed(), fixed(), fixed(), fixed());
+        let mut reel = Reel { last: None };
+        let mut dev = Devices {
+            length: &mut length,
+            swing: &mut swing,
+            orbit: &mut orbit,
+            reel: &mut reel,
+            tension: &mut load,
+        };
+        control_cycle(&mut ctl, 0, &mut dev, DriveFaults::NONE);
+        assert_eq!(ctl.output().health, Health::Nominal);
+        let mut stalled = DriveFaults::NONE;
+        stalled.insert(crate::reel_drive::DriveFault::MotorStall);
+        let c = control_cycle(&mut ctl, 1, &mut dev, stalled);
+        // The sensors were fine: the safe hold is the drive's doing.
+        assert_eq!((c.sensor_error, c.reel_error), (None, None));
+        assert_eq!(ctl.output().health, Health::SafeHold, "{:?}", ctl.output());
+        assert_eq!(reel.last, Some(ctl.output().rate_cmd_mps));
     }
 
     #[test]
@@ -326,12 +368,12 @@ mod tests {
             tension: &mut load,
         };
         for tick in 0..2 {
-            let c = control_cycle(&mut ctl, tick, &mut dev);
+            let c = control_cycle(&mut ctl, tick, &mut dev, DriveFaults::NONE);
             // The encoder gives no rate: a reading error, not a dropout.
             assert_eq!(c.sensor_error, None);
             assert_eq!(c.reading_error, Some(ErrorKind::NoSample));
         }
-        let c = control_cycle(&mut ctl, 2, &mut dev);
+        let c = control_cycle(&mut ctl, 2, &mut dev, DriveFaults::NONE);
         assert_eq!(c.reading_error, Some(ErrorKind::Device));
         let o = ctl.output();
         assert_eq!((o.fault, o.health), (None, Health::Nominal), "{o:?}");

@@ -32,6 +32,8 @@ compile_error!(
 
 #[cfg(target_os = "none")]
 use tss_reel::firmware::{self, clock::ControlClock, exit, mission, reel};
+#[cfg(target_os = "none")]
+use tss_reel::reel_drive::DriveFaults;
 
 /// Reset entry: start the clock, run the two rates until the mission ends, exit.
 ///
@@ -69,10 +71,13 @@ fn main() -> ! {
         clock.wait_for_tick();
         if tick.is_multiple_of(reel::OUTER_PERIOD_TICKS) {
             let period = tick / reel::OUTER_PERIOD_TICKS;
-            if period > 0 {
-                reel.log_period(period - 1, mission.output());
-            }
-            match mission.step(period) {
+            // The drive's faults over the period that ended reach the law's health.
+            let drive_faults = if period > 0 {
+                reel.log_period(period - 1, mission.output())
+            } else {
+                DriveFaults::NONE
+            };
+            match mission.step(period, drive_faults) {
                 mission::Flow::Continue => reel.command(mission.output(), tick),
                 mission::Flow::Finished => {
                     defmt::info!(

@@ -87,7 +87,7 @@ mod board {
     // crate docs), with its injected dropout, as the QEMU firmware's replay.
     use tss_reel::recordings::sensors::Replay;
     use tss_reel::reel_drive::hal::{HalReelDrive, LoadCell, MotorPins, QuadratureEncoder};
-    use tss_reel::reel_drive::{DriveConfig, RateCommand, SpeedLoop};
+    use tss_reel::reel_drive::{DriveConfig, DriveFaults, RateCommand, SpeedLoop};
 
     /// The core clock: the internal 16 MHz oscillator (HSI16), no PLL. Enough for a 1 kHz
     /// inner loop of ~200 instructions plus one ADC conversion; raising it (PLL to 170 MHz) is
@@ -134,6 +134,9 @@ mod board {
         drive: BoardDrive,
         /// The law's latest command, taken at the next inner tick.
         pending: Option<RateCommand>,
+        /// The faults of the inner ticks since the outer loop last took them (their union),
+        /// for the law's next step ([`control_cycle`]).
+        period_faults: DriveFaults,
     }
 
     /// Shared between the SysTick handler (inner loop) and the main loop (outer loop): every
@@ -268,9 +271,9 @@ mod board {
         ///
         /// Out of line: the symbol `scripts/panic-check` starts from for this board.
         #[inline(never)]
-        fn control(&mut self, period: u32) -> Option<RateCommand> {
+        fn control(&mut self, period: u32, drive: DriveFaults) -> Option<RateCommand> {
             self.devices.reel.latest = None;
-            let _ = control_cycle(&mut self.controller, period, &mut self.devices);
+            let _ = control_cycle(&mut self.controller, period, &mut self.devices, drive);
             self.devices.reel.latest
         }
     }
@@ -358,6 +361,7 @@ mod board {
             INNER.borrow(cs).replace(Some(Inner {
                 drive,
                 pending: None,
+                period_faults: DriveFaults::NONE,
             }));
         });
 
@@ -419,8 +423,16 @@ mod board {
                 period = now_period;
             }
 
+            // The drive's faults since the last law period reach the law's health.
+            let drive_faults = cortex_m::interrupt::free(|cs| {
+                let mut inner = INNER.borrow(cs).try_borrow_mut().ok()?;
+                inner
+                    .as_mut()
+                    .map(|i| core::mem::replace(&mut i.period_faults, DriveFaults::NONE))
+            })
+            .unwrap_or(DriveFaults::NONE);
             let cmd = if (period as usize) < SAMPLES.len() {
-                outer.control(period)
+                outer.control(period, drive_faults)
             } else {
                 None
             };
@@ -489,6 +501,7 @@ mod board {
                         let _ = inner.drive.set_command(cmd, tick);
                     }
                     let _ = inner.drive.tick(tick);
+                    inner.period_faults = inner.period_faults.union(inner.drive.output().faults);
                 }
             }
         });

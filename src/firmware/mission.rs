@@ -31,6 +31,7 @@ use tss_reel::recordings::replay::{
     DROPOUT_FROM_TICK, DROPOUT_UNTIL_TICK, ORBIT_RATE_RADPS, PERIOD_S, SAMPLES,
 };
 use tss_reel::recordings::sensors::Replay;
+use tss_reel::reel_drive::DriveFaults;
 
 /// Control period, ms: 1 s, the period of the paper's scenario and of the recording.
 pub const CONTROL_PERIOD_MS: u32 = 1_000;
@@ -126,12 +127,13 @@ impl Mission {
     /// Out of line on purpose: it is the flight ELF's symbol for the control path, from which
     /// `scripts/panic-check` proves that no panic is reachable.
     #[inline(never)]
-    fn control(&mut self, tick: u32) -> Cycle {
-        control_cycle(&mut self.controller, tick, &mut self.devices)
+    fn control(&mut self, tick: u32, drive: DriveFaults) -> Cycle {
+        control_cycle(&mut self.controller, tick, &mut self.devices, drive)
     }
 
-    /// One control step at tick `tick` (0 for the first).
-    pub fn step(&mut self, tick: u32) -> Flow {
+    /// One control step at tick `tick` (0 for the first); `drive` is what the reel's speed
+    /// loop reported over the law period that ended (the union of its ticks' faults).
+    pub fn step(&mut self, tick: u32, drive: DriveFaults) -> Flow {
         if tick == 0 {
             defmt::info!(
                 "replay: {=usize} s of scenarios/paper.toml, n = {=f32} rad/s, dropout at ticks {=u32}..{=u32}",
@@ -152,7 +154,7 @@ impl Mission {
             return Flow::Finished;
         }
 
-        let cycle = self.control(tick);
+        let cycle = self.control(tick, drive);
         // In detail (`DEFMT_LOG=debug`): what this cycle sensed and what it commanded.
         match Replay::sample(tick) {
             // (The recording's α̇ is not a sensor that flies: the controller estimates it.)

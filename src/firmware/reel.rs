@@ -112,7 +112,10 @@ impl<'a> Reel<'a> {
     /// Logs the law period `period` that just ended: the command it had, and where the drum
     /// got to under it (speed from the encoder, duty, brake, the period's faults); then starts
     /// the next period's fault set.
-    pub fn log_period(&mut self, period: u32, command: &Output<f32>) {
+    ///
+    /// Returns the period's faults (the union of its ticks'), for the law's next step
+    /// ([`tss_reel::hal::control_cycle`]), and starts the next period's set.
+    pub fn log_period(&mut self, period: u32, command: &Output<f32>) -> DriveFaults {
         let out = self.drive.output();
         let brake = match out.brake {
             Brake::Engaged => "engaged",
@@ -129,6 +132,6 @@ impl<'a> Reel<'a> {
             brake,
             self.period_faults.bits()
         );
-        self.period_faults = DriveFaults::NONE;
+        core::mem::replace(&mut self.period_faults, DriveFaults::NONE)
     }
 }

@@ -143,7 +143,12 @@ mod tests {
         let mut dropouts = 0;
         for (tick, s) in SAMPLES.iter().enumerate() {
             let tick = tick as u32;
-            let cycle = control_cycle(&mut via_devices, tick, &mut dev);
+            let cycle = control_cycle(
+                &mut via_devices,
+                tick,
+                &mut dev,
+                crate::reel_drive::DriveFaults::NONE,
+            );
             let expected = if (DROPOUT_FROM_TICK..DROPOUT_UNTIL_TICK).contains(&tick) {
                 dropouts += 1;
                 assert_eq!(cycle.sensor_error, Some(ErrorKind::NoSample));
