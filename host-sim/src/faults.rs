@@ -17,6 +17,7 @@ use tss_reel::controller::{Envelope, Fault, Flags, Health, Output};
 use tss_reel::Real;
 
 use crate::reel::ReelDrive;
+use crate::sensors::{EncoderModel, LoadCellModel, SwingSensorModel};
 
 // ---- a small deterministic generator ---------------------------------------------------------
 
@@ -111,6 +112,10 @@ pub enum SensedQuantity {
     AlphaRate,
     /// The orbit rate θ̇, rad/s.
     OrbitRate,
+    /// The reel's rate from the encoder, m/s.
+    ReelRate,
+    /// The tension from the load cell, N.
+    Tension,
 }
 
 impl SensedQuantity {
@@ -121,6 +126,8 @@ impl SensedQuantity {
             Self::Alpha => "alpha",
             Self::AlphaRate => "alpha_rate",
             Self::OrbitRate => "orbit_rate",
+            Self::ReelRate => "reel_rate",
+            Self::Tension => "tension",
         }
     }
 }
@@ -167,12 +174,16 @@ pub struct Glitch {
 pub struct InjectionPlan {
     /// Seed of the noise generators (one stream per sensor).
     pub seed: u64,
-    /// The length encoder's errors.
-    pub length: SensorErrors,
-    /// The α sensor's errors.
-    pub alpha: SensorErrors,
+    /// The reel encoder (length and rate).
+    pub length: EncoderModel,
+    /// The swing sensor (α): errors, latency, α dropouts.
+    pub alpha: SwingSensorModel,
+    /// The α̇ sensor is fitted.
+    pub alpha_rate_enabled: bool,
     /// The α̇ sensor's errors.
     pub alpha_rate: SensorErrors,
+    /// The load cell.
+    pub load_cell: LoadCellModel,
     /// Windows without a sample (the controller's `step_missing`).
     pub dropout: Vec<Window>,
     /// Corrupted readings.
@@ -182,11 +193,14 @@ pub struct InjectionPlan {
 }
 
 impl InjectionPlan {
-    /// `true` if nothing is injected: the controller reads the truth (rounded to its type).
+    /// `true` if nothing is injected: the controller reads the truth (rounded to its type),
+    /// α̇ included.
     pub fn is_transparent(&self) -> bool {
         self.length.is_perfect()
             && self.alpha.is_perfect()
+            && self.alpha_rate_enabled
             && self.alpha_rate.is_perfect()
+            && self.load_cell.is_perfect()
             && self.dropout.is_empty()
             && self.corrupt.is_empty()
             && self.length_glitch.is_empty()
@@ -210,14 +224,14 @@ pub struct Truth {
 
 /// One sensor: bias, noise, quantisation, stuck window.
 #[derive(Clone, Debug)]
-struct Channel {
+pub(crate) struct Channel {
     cfg: SensorErrors,
     rng: Pcg32,
     held: Option<f64>,
 }
 
 impl Channel {
-    fn new(cfg: &SensorErrors, seed: u64, stream: u64) -> Self {
+    pub(crate) fn new(cfg: &SensorErrors, seed: u64, stream: u64) -> Self {
         Self {
             cfg: cfg.clone(),
             rng: Pcg32::new(seed, stream),
@@ -225,7 +239,7 @@ impl Channel {
         }
     }
 
-    fn read(&mut self, truth: f64, t_s: f64) -> f64 {
+    pub(crate) fn read(&mut self, truth: f64, t_s: f64) -> f64 {
         let c = &self.cfg;
         // Drawn every tick, used or not, so that the noise sequence is tied to time.
         let noise = if c.noise_std > 0.0 {
@@ -278,8 +292,8 @@ impl Injector {
     /// The injector of `plan` on control period `period_s`.
     pub fn new(plan: &InjectionPlan, period_s: f64) -> Self {
         Self {
-            length: Channel::new(&plan.length, plan.seed, 1),
-            alpha: Channel::new(&plan.alpha, plan.seed, 2),
+            length: Channel::new(&plan.length.errors, plan.seed, 1),
+            alpha: Channel::new(&plan.alpha.errors, plan.seed, 2),
             alpha_rate: Channel::new(&plan.alpha_rate, plan.seed, 3),
             dropout: plan.dropout.clone(),
             corrupt: plan.corrupt.clone(),
@@ -314,6 +328,7 @@ impl Injector {
                     SensedQuantity::Alpha => r.alpha_rad = c.value,
                     SensedQuantity::AlphaRate => r.alpha_rate_radps = c.value,
                     SensedQuantity::OrbitRate => r.orbit_rate_radps = c.value,
+                    SensedQuantity::ReelRate | SensedQuantity::Tension => {}
                 }
             }
         }
@@ -736,9 +751,10 @@ pub fn injected_faults(setup: &FaultSetup) -> Vec<String> {
     let mut v = Vec::new();
     let plan = &setup.injection;
     for (name, c) in [
-        ("length (m)", &plan.length),
-        ("alpha (rad)", &plan.alpha),
+        ("length (m)", &plan.length.errors),
+        ("alpha (rad)", &plan.alpha.errors),
         ("alpha_rate (rad/s)", &plan.alpha_rate),
+        ("tension (N)", &plan.load_cell.errors),
     ] {
         let mut parts = Vec::new();
         if c.noise_std > 0.0 {
@@ -757,8 +773,38 @@ pub fn injected_faults(setup: &FaultSetup) -> Vec<String> {
             v.push(format!("sensor {name}: {}", parts.join(", ")));
         }
     }
-    if v.iter().any(|l| l.contains("noise")) {
+    if v.iter().any(|l| l.contains("noise")) || plan.alpha.dropout_prob > 0.0 {
         v.push(format!("noise seed {}", plan.seed));
+    }
+    if let Some(q) = plan.length.count_m() {
+        v.push(format!(
+            "reel encoder: {} counts per revolution of a {} m drum ({:.4e} m per count)",
+            plan.length.counts_per_rev, plan.length.drum_radius_m, q
+        ));
+    }
+    let a = &plan.alpha;
+    if a.latency_periods > 0 {
+        v.push(format!(
+            "swing sensor latency: {} periods",
+            a.latency_periods
+        ));
+    }
+    if a.dropout_prob > 0.0 {
+        v.push(format!(
+            "swing sensor: no α with probability {}",
+            a.dropout_prob
+        ));
+    }
+    for w in &a.dropout {
+        v.push(format!("no α {}", window(w.from_s, w.until_s)));
+    }
+    if !plan.load_cell.enabled {
+        v.push("no load cell".to_string());
+    } else if plan.load_cell.full_scale_n < f64::INFINITY {
+        v.push(format!(
+            "load cell full scale {} N",
+            plan.load_cell.full_scale_n
+        ));
     }
     for w in &plan.dropout {
         v.push(format!(

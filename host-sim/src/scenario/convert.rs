@@ -18,10 +18,12 @@ use crate::faults::{
     Corruption, FaultSetup, Glitch, InjectionPlan, SensedQuantity, SensorErrors, Window,
 };
 use crate::reel::{Reel, ReelDrive};
+use crate::sensors::{EncoderModel, LoadCellModel, SwingSensorModel};
 
 use super::{
-    EnvelopeSection, MonitorSection, ReelModelName, ReelSection, Scenario, SensedDirection,
-    SensorName, SensorSection, WindowSection,
+    EncoderSection, EnvelopeSection, LoadCellSection, MonitorSection, RateSensorSection,
+    ReelModelName, ReelSection, Scenario, SensedDirection, SensorName, SwingSensorSection,
+    WindowSection,
 };
 
 impl Scenario {
@@ -103,18 +105,68 @@ impl MonitorSection {
     }
 }
 
-impl From<&SensorSection> for SensorErrors {
-    fn from(s: &SensorSection) -> Self {
+/// A sensor's bias, noise, quantum and stuck window (`stuck_from_s = inf`, the default, is
+/// never).
+fn errors(noise_std: f64, bias: f64, quantum: f64, stuck: (f64, f64)) -> SensorErrors {
+    SensorErrors {
+        noise_std,
+        bias,
+        quantum,
+        stuck: (stuck.0 != f64::INFINITY).then_some(Window {
+            from_s: stuck.0,
+            until_s: stuck.1,
+        }),
+    }
+}
+
+impl From<&EncoderSection> for EncoderModel {
+    fn from(s: &EncoderSection) -> Self {
         Self {
-            noise_std: s.noise_std,
-            bias: s.bias,
-            quantum: s.quantum,
-            // `stuck_from_s = inf` (the default) is never.
-            stuck: (s.stuck_from_s != f64::INFINITY).then_some(Window {
-                from_s: s.stuck_from_s,
-                until_s: s.stuck_until_s,
-            }),
+            errors: errors(
+                s.noise_std,
+                s.bias,
+                s.quantum,
+                (s.stuck_from_s, s.stuck_until_s),
+            ),
+            counts_per_rev: s.counts_per_rev,
+            drum_radius_m: s.drum_radius_m,
         }
+    }
+}
+
+impl From<&RateSensorSection> for SensorErrors {
+    fn from(s: &RateSensorSection) -> Self {
+        errors(
+            s.noise_std,
+            s.bias,
+            s.quantum,
+            (s.stuck_from_s, s.stuck_until_s),
+        )
+    }
+}
+
+impl From<&LoadCellSection> for LoadCellModel {
+    fn from(s: &LoadCellSection) -> Self {
+        Self {
+            enabled: s.enabled,
+            errors: errors(s.noise_std_n, s.bias_n, s.quantum_n, (f64::INFINITY, 0.0)),
+            full_scale_n: s.full_scale_n,
+        }
+    }
+}
+
+/// The swing sensor of `[sensors.alpha]` with the α dropouts of `[[faults.alpha_dropout]]`.
+fn swing_sensor(s: &SwingSensorSection, dropout: &[WindowSection]) -> SwingSensorModel {
+    SwingSensorModel {
+        errors: errors(
+            s.noise_std,
+            s.bias,
+            s.quantum,
+            (s.stuck_from_s, s.stuck_until_s),
+        ),
+        latency_periods: s.latency_periods,
+        dropout_prob: s.dropout_prob,
+        dropout: dropout.iter().map(Window::from).collect(),
     }
 }
 
@@ -125,6 +177,8 @@ impl From<SensorName> for SensedQuantity {
             SensorName::Alpha => Self::Alpha,
             SensorName::AlphaRate => Self::AlphaRate,
             SensorName::OrbitRate => Self::OrbitRate,
+            SensorName::ReelRate => Self::ReelRate,
+            SensorName::Tension => Self::Tension,
         }
     }
 }
@@ -145,8 +199,10 @@ impl From<&Scenario> for InjectionPlan {
         Self {
             seed: s.seed,
             length: (&s.length).into(),
-            alpha: (&s.alpha).into(),
+            alpha: swing_sensor(&s.alpha, &f.alpha_dropout),
+            alpha_rate_enabled: s.alpha_rate.enabled,
             alpha_rate: (&s.alpha_rate).into(),
+            load_cell: (&s.load_cell).into(),
             dropout: f.dropout.iter().map(Window::from).collect(),
             corrupt: f
                 .corrupt

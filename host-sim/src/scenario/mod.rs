@@ -80,8 +80,9 @@ pub use plant::{PlantModel, PlantSection, SensedDirection};
 pub use reel::{ReelModelName, ReelSection};
 pub use schema::{schema, LeafKind, Schema};
 pub use sensors::{
-    CorruptSection, FaultsSection, GlitchSection, SensorName, SensorSection, SensorsSection,
-    WindowSection, MAX_FAULT_ENTRIES,
+    CorruptSection, EncoderSection, FaultsSection, GlitchSection, LoadCellSection,
+    RateSensorSection, SensorName, SensorsSection, SwingSensorSection, WindowSection,
+    MAX_FAULT_ENTRIES,
 };
 pub use simulation::{
     SimulationSection, MAX_HISTORY_ROWS, MAX_PLANT_STEPS, MAX_SUBSTEPS, MAX_TICKS,

@@ -141,7 +141,9 @@ fn schema_lists_every_key() {
             "length",
             "alpha",
             "alpha_rate",
-            "orbit_rate"
+            "orbit_rate",
+            "reel_rate",
+            "tension"
         ]))
     );
 }
@@ -680,11 +682,13 @@ fn a_campaign_disperses_each_field_at_most_once() {
 fn conversions_keep_the_meaning_of_the_defaults() {
     use crate::faults::{InjectionPlan, SensorErrors, Window};
     use crate::reel::ReelDrive;
-    let s = load(&[]).unwrap();
+    // The default has no α̇ sensor (the controller estimates α̇): not the paper's idealisation.
+    assert!(!InjectionPlan::from(&load(&[]).unwrap()).is_transparent());
+    let s = load(&["sensors.alpha_rate.enabled=true"]).unwrap();
     assert!(InjectionPlan::from(&s).is_transparent());
     assert!(ReelDrive::from(&s.reel).is_ideal());
     assert_eq!(
-        SensorErrors::from(&SensorSection::default()),
+        SensorErrors::from(&super::RateSensorSection::default()),
         SensorErrors::default()
     );
     let s = load(&[
@@ -695,13 +699,13 @@ fn conversions_keep_the_meaning_of_the_defaults() {
     .unwrap();
     let plan = InjectionPlan::from(&s);
     assert_eq!(
-        plan.alpha.stuck,
+        plan.alpha.errors.stuck,
         Some(Window {
             from_s: 50.0,
             until_s: f64::INFINITY
         })
     );
-    assert_eq!(plan.length.bias, 0.5);
+    assert_eq!(plan.length.errors.bias, 0.5);
     assert!(!plan.is_transparent());
     assert!(!ReelDrive::from(&s.reel).is_ideal());
     let cfg = s.controller_config::<f32>();
