@@ -2,6 +2,9 @@
 
 use rayon::prelude::*;
 
+use tss_reel::controller::Controller;
+
+use super::consistency::{ConsistencySums, RunConsistency, Watched};
 use crate::faults::Pcg32;
 use crate::history::History;
 use crate::report::summarize;
@@ -471,11 +474,32 @@ impl Campaign {
 
     /// Flies run `index` and judges it.
     pub fn run(&self, index: u64) -> RunRecord {
+        self.fly(index, false).0
+    }
+
+    /// Flies run `index` and judges it; with `watch`, the flight filter flies beside the
+    /// controller and the run's NEES and NIS come back too (`None` if the run did not
+    /// complete).
+    pub fn fly(&self, index: u64, watch: bool) -> (RunRecord, Option<RunConsistency>) {
         let inputs = self.draw(index);
         let sensor_seed = run_seed(self.seed, index, SENSOR_STREAM);
+        let mut consistency = None;
         let result = self.scenario_for(index, &inputs).and_then(|sc| {
             let probes = probe_times_for(&sc);
-            crate::sim::run(&sc, &probes, &mut |_| {})
+            let history = if watch {
+                let mut ctl = crate::sim::controller_config::<f32>(&sc)
+                    .and_then(|c| Controller::new(c).map_err(crate::sim::SimError::Config))
+                    .map_err(|e| e.to_string())?;
+                let mut watched = Watched::new(&sc, &mut ctl).map_err(|e| e.to_string())?;
+                let h = crate::sim::run_stepper(&sc, &mut watched, &probes, &mut |_| {});
+                if let Ok(h) = &h {
+                    consistency = Some(watched.finish(h, sc.controller.period_s));
+                }
+                h
+            } else {
+                crate::sim::run(&sc, &probes, &mut |_| {})
+            };
+            history
                 .map(|h| Outcome::of(&sc, &h))
                 .map_err(|e| e.to_string())
         });
@@ -486,14 +510,15 @@ impl Campaign {
             }
             Err(e) => (None, vec![Criterion::Completed], e),
         };
-        RunRecord {
+        let record = RunRecord {
             run: index,
             sensor_seed,
             inputs,
             outcome,
             failed,
             error,
-        }
+        };
+        (record, consistency)
     }
 
     /// Flies the runs `indices` on `threads` threads (0: one per core), calling `done` after
@@ -504,22 +529,41 @@ impl Campaign {
         threads: usize,
         done: &(dyn Fn() + Sync),
     ) -> anyhow::Result<Vec<RunRecord>> {
+        Ok(self.run_all_watched(indices, threads, false, done)?.0)
+    }
+
+    /// [`Campaign::run_all`], with `watch` the estimator's consistency summed over the runs
+    /// (in run order, so the sums do not depend on the thread count).
+    pub fn run_all_watched(
+        &self,
+        indices: &[u64],
+        threads: usize,
+        watch: bool,
+        done: &(dyn Fn() + Sync),
+    ) -> anyhow::Result<(Vec<RunRecord>, Option<ConsistencySums>)> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .map_err(|e| anyhow::anyhow!("cannot start {threads} threads: {e}"))?;
-        let mut records: Vec<RunRecord> = pool.install(|| {
+        let mut flown: Vec<(RunRecord, Option<RunConsistency>)> = pool.install(|| {
             indices
                 .par_iter()
                 .map(|&i| {
-                    let r = self.run(i);
+                    let r = self.fly(i, watch);
                     done();
                     r
                 })
                 .collect()
         });
-        records.sort_by_key(|r| r.run);
-        Ok(records)
+        flown.sort_by_key(|(r, _)| r.run);
+        let sums = watch.then(|| {
+            let mut sums = ConsistencySums::default();
+            for c in flown.iter().filter_map(|(_, c)| c.as_ref()) {
+                sums.add(c);
+            }
+            sums
+        });
+        Ok((flown.into_iter().map(|(r, _)| r).collect(), sums))
     }
 }
 

@@ -10,6 +10,8 @@ use tss_reel::orbit::Orbit;
 use tss_reel::schedule::BandSchedule;
 use tss_reel::Real;
 
+use tss_reel::estimator;
+
 use crate::elastic::environment::Environment;
 use crate::elastic::reel_drum::DrumParams;
 use crate::elastic::tether::TetherParams;
@@ -26,7 +28,25 @@ use super::{
     WindowSection,
 };
 
+/// The smallest α noise the estimator is told, rad (its `Config::validate` floor): an ideal
+/// swing sensor is flown as one this good.
+pub const MIN_ASSUMED_ALPHA_NOISE_RAD: f64 = 1e-6;
+
 impl Scenario {
+    /// The libration estimator's tuning for this scenario's swing sensor:
+    /// `estimator::Config::paper()` at the control period, told the sensor's noise (at least
+    /// the filter's floor of 1e-6 rad) and quantum. The filter then assumes what the sensor's
+    /// data sheet would say; its bias, latency and dropouts are the filter's to cope with.
+    pub fn estimator_config<T: Real>(&self) -> estimator::Config<T> {
+        let a = &self.sensors.alpha;
+        estimator::Config {
+            period_s: T::from_f64(self.controller.period_s),
+            alpha_noise_rad: T::from_f64(a.noise_std.max(MIN_ASSUMED_ALPHA_NOISE_RAD)),
+            alpha_quantum_rad: T::from_f64(a.quantum),
+            ..estimator::Config::paper()
+        }
+    }
+
     /// The flight controller's configuration, in its scalar type `T` (f32 on the target): the
     /// numbers `Config::validate` judges. The stage-2 start is the nearest control tick.
     pub fn controller_config<T: Real>(&self) -> Config<T> {
