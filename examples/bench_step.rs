@@ -197,10 +197,11 @@ mod bench {
             (cfg.stage1.decay_rate_per_s, cfg.initial_rate_mps)
         };
         let masses = cfg.masses;
+        // The α and α̇ the step flew (α_r + δ, α̇_r + δ̇: the sensed ones, or the estimate).
         let law_in = LawInput {
             length_m: l,
-            alpha_rad: x.alpha_rad,
-            alpha_rate_radps: x.alpha_rate_radps,
+            alpha_rad: out.alpha_ref_rad + out.delta_rad,
+            alpha_rate_radps: out.alpha_ref_rate_radps + out.delta_rate_radps,
             orbit_rate_radps: x.orbit_rate_radps,
             ref_angle_rad: reference.angle.angle_rad,
             ref_slope_rad_per_m: reference.angle.slope_rad_per_m,
@@ -263,9 +264,12 @@ mod bench {
             let input = sample(tick).map(|s| Input {
                 tick,
                 length_m: s[0],
-                alpha_rad: s[1],
-                alpha_rate_radps: s[2],
+                reel_rate_mps: None,
+                tension_n: None,
+                alpha_rad: Some(s[1]),
+                alpha_rate_radps: Some(s[2]),
                 orbit_rate_radps,
+                true_anomaly_rad: 0.0,
             });
             let mut copies: [Controller<f32>; K] = core::array::from_fn(|_| ctl.clone());
             let cost = match &input {

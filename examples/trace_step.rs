@@ -33,9 +33,12 @@ fn main() -> ! {
         let x = Input {
             tick,
             length_m: s[0],
-            alpha_rad: s[1],
-            alpha_rate_radps: s[2],
+            reel_rate_mps: None,
+            tension_n: None,
+            alpha_rad: Some(s[1]),
+            alpha_rate_radps: Some(s[2]),
             orbit_rate_radps: mission::ORBIT_RATE_RADPS,
+            true_anomaly_rad: 0.0,
         };
         black_box(ctl.step(black_box(&x)));
     }

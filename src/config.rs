@@ -5,6 +5,7 @@
 //! are typed and name the parameter (its path in [`Config`]) and the value.
 
 use crate::envelope::Envelope;
+use crate::estimator;
 use crate::law::Gains;
 use crate::mass::MassModel;
 use crate::orbit::Orbit;
@@ -154,6 +155,20 @@ pub struct Config<T> {
     pub envelope: Envelope<T>,
     /// Sensor checks and fault timing.
     pub monitor: MonitorConfig<T>,
+    /// Where the law's α and α̇ come from.
+    pub rate_source: RateSource<T>,
+}
+
+/// Where the law's α and α̇ come from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RateSource<T> {
+    /// The sensed α and α̇ ([`Input::alpha_rate_radps`](crate::monitor::Input::alpha_rate_radps)):
+    /// the paper's assumption of a measured α̇, kept for Table 1 and for comparison. A sample
+    /// without α or α̇ is a bad sample.
+    Sensor,
+    /// The onboard estimator ([`crate::estimator`]) on the sensed α alone: what flies, since
+    /// no flight sensor measures α̇ (issue 18).
+    Estimator(estimator::Config<T>),
 }
 
 impl<T: Real> Config<T> {
@@ -191,6 +206,7 @@ impl<T: Real> Config<T> {
                 max_length_m: T::from_f64(40_000.0),
             },
             monitor: MonitorConfig::default_for_period(),
+            rate_source: RateSource::Sensor,
         }
     }
 
@@ -251,6 +267,9 @@ impl<T: Real> Config<T> {
             }
         }
         positive("stage2.slew_rate_radps", self.stage2.slew_rate_radps)?;
+        if let RateSource::Estimator(est) = &self.rate_source {
+            validate_estimator(est, self.period_s)?;
+        }
         positive("keep_capture_m", self.keep_capture_m)?;
         let env = &self.envelope;
         self.monitor.validate()?;
@@ -351,6 +370,44 @@ pub fn fastest_eq28_pole_per_s<T: Real>(k1_per_s: T, k2_per_s2: T) -> f64 {
     }
 }
 
+/// The estimator's parameters, its errors mapped to their path in [`Config`]
+/// (`rate_source.estimator.alpha_noise_rad`); its period must be the controller's.
+fn validate_estimator<T: Real>(est: &estimator::Config<T>, period_s: T) -> Result<(), ConfigError> {
+    est.validate().map_err(|e| ConfigError {
+        param: estimator_path(e.param),
+        value: e.value,
+        rule: if e.value.is_finite() {
+            Rule::OutOfRange
+        } else {
+            Rule::NotFinite
+        },
+    })?;
+    if est.period_s != period_s {
+        return Err(ConfigError::new(
+            "rate_source.estimator.period_s",
+            est.period_s,
+            Rule::NotThePeriod,
+        ));
+    }
+    Ok(())
+}
+
+/// The path in [`Config`] of an estimator parameter named by [`estimator::ConfigError`].
+fn estimator_path(param: &'static str) -> &'static str {
+    match param {
+        "period_s" => "rate_source.estimator.period_s",
+        "alpha_noise_rad" => "rate_source.estimator.alpha_noise_rad",
+        "alpha_quantum_rad" => "rate_source.estimator.alpha_quantum_rad",
+        "accel_noise_density" => "rate_source.estimator.accel_noise_density",
+        "disturbance_drift_density" => "rate_source.estimator.disturbance_drift_density",
+        "initial_rate_std_radps" => "rate_source.estimator.initial_rate_std_radps",
+        "initial_disturbance_std_radps2" => "rate_source.estimator.initial_disturbance_std_radps2",
+        "gate_nis" => "rate_source.estimator.gate_nis",
+        "max_rejections" => "rate_source.estimator.max_rejections",
+        _ => "rate_source.estimator",
+    }
+}
+
 pub(crate) fn finite<T: Real>(param: &'static str, v: T) -> Result<(), ConfigError> {
     if v.is_finite() {
         Ok(())
@@ -411,6 +468,11 @@ pub enum Rule {
     /// A rate too fast for the control period to represent: the fastest Eq. 28 closed-loop
     /// pole or a blend decay rate, times the period, above [`MAX_POLE_PERIOD_PRODUCT`].
     TooFastForPeriod,
+    /// Outside the range its module admits (an estimator parameter: see
+    /// [`estimator::Config::validate`]).
+    OutOfRange,
+    /// Not the controller's control period (the estimator's `period_s`).
+    NotThePeriod,
     /// So large that a derived count overflows (`monitor.coast_ticks ×
     /// monitor.good_samples_per_bad`).
     TooLarge,

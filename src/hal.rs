@@ -154,9 +154,12 @@ where
             Ok(Input {
                 tick,
                 length_m,
-                alpha_rad: swing.alpha_rad,
-                alpha_rate_radps: swing.alpha_rate_radps,
+                reel_rate_mps: None,
+                tension_n: None,
+                alpha_rad: Some(swing.alpha_rad),
+                alpha_rate_radps: Some(swing.alpha_rate_radps),
                 orbit_rate_radps: n,
+                true_anomaly_rad: 0.0,
             })
         });
     let (output, sensor_error) = match sample {

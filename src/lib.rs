@@ -26,9 +26,12 @@
 //!     let out = ctl.step(&Input {
 //!         tick: 0,                          // whole control periods since the start
 //!         length_m: 1.0,                    // l, m
-//!         alpha_rad: -35f32.to_radians(),   // α, rad (deploying: behind the main satellite)
-//!         alpha_rate_radps: 0.0,            // α̇, rad/s
+//!         reel_rate_mps: None,              // l̇ from the reel's encoder, m/s (not used here)
+//!         tension_n: None,                  // tension from the load cell, N (not used here)
+//!         alpha_rad: Some(-35f32.to_radians()), // α, rad (deploying: behind the main satellite)
+//!         alpha_rate_radps: Some(0.0),      // α̇, rad/s (the paper's measured α̇)
 //!         orbit_rate_radps: 1.0602e-3,      // n, rad/s (circular orbit, R = 7078 km)
+//!         true_anomaly_rad: 0.0,            // θ, rad (used on an eccentric orbit only)
 //!     });
 //!     // Phase and health changes, faults and blend restarts, each queued once: read them every
 //!     // period (here: stage 1's blend starts).

@@ -752,8 +752,9 @@ pub fn fnv1a_f32(hash: u32, x: f32) -> u32 {
 /// host-linked run it is compared with. Every struct is destructured without `..`: a new field
 /// anywhere in the configuration does not compile until it is added here.
 pub fn config_digest(cfg: &crate::controller::Config<f32>) -> u32 {
-    use crate::config::{Stage1Config, Stage2Config};
+    use crate::config::{RateSource, Stage1Config, Stage2Config};
     use crate::controller::{Config, Envelope, MonitorConfig};
+    use crate::estimator;
     use crate::law::Gains;
     use crate::mass::MassModel;
     use crate::orbit::Orbit;
@@ -770,6 +771,7 @@ pub fn config_digest(cfg: &crate::controller::Config<f32>) -> u32 {
         keep_capture_m,
         envelope,
         monitor,
+        rate_source,
     } = cfg;
     let Orbit {
         semi_major_axis_m,
@@ -877,6 +879,38 @@ pub fn config_digest(cfg: &crate::controller::Config<f32>) -> u32 {
         good_samples_per_bad,
     ] {
         h = fnv1a(h, &n.to_le_bytes());
+    }
+    // The rate source: nothing for the rate sensor (the digest of a configuration from before
+    // there was a choice is unchanged), a tag and the estimator's parameters otherwise.
+    match rate_source {
+        RateSource::Sensor => {}
+        RateSource::Estimator(est) => {
+            let estimator::Config {
+                period_s,
+                alpha_noise_rad,
+                alpha_quantum_rad,
+                accel_noise_density,
+                disturbance_drift_density,
+                initial_rate_std_radps,
+                initial_disturbance_std_radps2,
+                gate_nis,
+                max_rejections,
+            } = est;
+            h = fnv1a(h, &[1]);
+            h = [
+                period_s,
+                alpha_noise_rad,
+                alpha_quantum_rad,
+                accel_noise_density,
+                disturbance_drift_density,
+                initial_rate_std_radps,
+                initial_disturbance_std_radps2,
+                gate_nis,
+            ]
+            .into_iter()
+            .fold(h, |h, &x| fnv1a_f32(h, x));
+            h = fnv1a(h, &max_rejections.to_le_bytes());
+        }
     }
     h
 }

@@ -16,14 +16,24 @@ pub use crate::config::MonitorConfig;
 pub struct Input<T> {
     /// Tick count of this sample (mission time = tick × period).
     pub tick: u32,
-    /// Sensed tether length l, m.
+    /// Length from the reel encoder, m.
     pub length_m: T,
-    /// Sensed in-plane angle α, rad.
-    pub alpha_rad: T,
-    /// Sensed in-plane rate α̇, rad/s.
-    pub alpha_rate_radps: T,
-    /// Orbit rate n (θ̇), rad/s.
+    /// The reel's rate measured by its encoder, m/s (None: not measured this period).
+    pub reel_rate_mps: Option<T>,
+    /// Tension at the reel from the load cell, N (None: no load cell, or no sample).
+    pub tension_n: Option<T>,
+    /// In-plane angle α from the swing sensor, rad (None: the swing sensor gave nothing this
+    /// period; the estimator predicts only).
+    pub alpha_rad: Option<T>,
+    /// α̇ from an optional rate sensor, rad/s: used only by a controller configured to fly on
+    /// it ([`RateSource::Sensor`](crate::config::RateSource::Sensor), the paper's
+    /// idealisation, used for Table 1); None in flight.
+    pub alpha_rate_radps: Option<T>,
+    /// Orbit rate θ̇, rad/s.
     pub orbit_rate_radps: T,
+    /// True anomaly θ, rad, from the onboard orbit source (used on an eccentric orbit;
+    /// ignored when the configured eccentricity is 0).
+    pub true_anomaly_rad: T,
 }
 
 /// Which sensed value was rejected, and why.
@@ -39,13 +49,13 @@ pub enum Sensor {
     Length,
     /// Length differs from the length predicted from the command by more than allowed.
     LengthJump,
-    /// α NaN, infinite or |α| > π.
+    /// α missing (flying on a rate sensor), NaN, infinite or |α| > π.
     Alpha,
     /// α jumped further than α̇ allows.
     AlphaJump,
     /// α repeats exactly while α̇ says the tether is moving.
     AlphaStuck,
-    /// α̇ NaN, infinite or beyond its plausible range.
+    /// α̇ missing (flying on a rate sensor), NaN, infinite or beyond its plausible range.
     AlphaRate,
     /// Orbit rate NaN, infinite or outside [min, max].
     OrbitRate,
@@ -119,27 +129,33 @@ impl<T: Real> Monitor<T> {
         })
     }
 
-    /// Checks one sample. `expected_length_m` is the length the controller predicts for this
-    /// tick (`None` when it has no trustworthy prediction). The controller never checks a
-    /// sample whose tick is before the last accepted one (it rejects a tick that goes
-    /// backwards first).
+    /// Checks one sample of a controller flying on a rate sensor, and returns its α and α̇
+    /// (rad, rad/s). A sample without α or α̇ is rejected ([`Sensor::Alpha`],
+    /// [`Sensor::AlphaRate`]), as a missing sensor. `expected_length_m` is the length the
+    /// controller predicts for this tick (`None` when it has no trustworthy prediction). The
+    /// controller never checks a sample whose tick is before the last accepted one (it rejects
+    /// a tick that goes backwards first).
     pub(crate) fn check(
         &mut self,
         cfg: &MonitorConfig<T>,
         x: &Input<T>,
         expected_length_m: Option<T>,
         period_s: T,
-    ) -> Result<(), Sensor> {
+    ) -> Result<(T, T), Sensor> {
         // Range checks: each is false for NaN, and a finite bound excludes the infinities.
         if !within(x.length_m, self.min_length_m, self.max_length_m) {
             return Err(Sensor::Length);
         }
-        if !magnitude_within(x.alpha_rad, T::from_f64(core::f64::consts::PI)) {
+        let pi = T::from_f64(core::f64::consts::PI);
+        let Some(alpha_rad) = x.alpha_rad.filter(|&a| magnitude_within(a, pi)) else {
             return Err(Sensor::Alpha);
-        }
-        if !magnitude_within(x.alpha_rate_radps, cfg.max_alpha_rate_radps) {
+        };
+        let Some(alpha_rate_radps) = x
+            .alpha_rate_radps
+            .filter(|&r| magnitude_within(r, cfg.max_alpha_rate_radps))
+        else {
             return Err(Sensor::AlphaRate);
-        }
+        };
         if !within(
             x.orbit_rate_radps,
             cfg.min_orbit_rate_radps,
@@ -155,23 +171,23 @@ impl<T: Real> Monitor<T> {
         let Some(last) = &mut self.last else {
             self.last = Some(Accepted {
                 tick: x.tick,
-                alpha_rad: x.alpha_rad,
-                alpha_rate_radps: x.alpha_rate_radps,
+                alpha_rad,
+                alpha_rate_radps,
                 same_alpha_count: 1,
                 implied_motion_rad: T::ZERO,
             });
-            return Ok(());
+            return Ok((alpha_rad, alpha_rate_radps));
         };
         // At least one tick's allowance (a repeated tick predicts no motion).
         let ticks = T::from_u32(x.tick.wrapping_sub(last.tick).max(1));
         let predicted = last.alpha_rad + last.alpha_rate_radps * (ticks * period_s);
-        if (x.alpha_rad - predicted).abs() > cfg.alpha_jump_rad * ticks {
+        if (alpha_rad - predicted).abs() > cfg.alpha_jump_rad * ticks {
             return Err(Sensor::AlphaJump);
         }
         // Stuck: the same reading again and again while α̇ says it should have moved.
-        if x.alpha_rad == last.alpha_rad {
+        if alpha_rad == last.alpha_rad {
             last.same_alpha_count = last.same_alpha_count.saturating_add(1);
-            last.implied_motion_rad = last.implied_motion_rad + x.alpha_rate_radps.abs() * period_s;
+            last.implied_motion_rad = last.implied_motion_rad + alpha_rate_radps.abs() * period_s;
             if last.same_alpha_count >= cfg.stuck_ticks
                 && last.implied_motion_rad >= cfg.stuck_motion_rad
             {
@@ -183,9 +199,9 @@ impl<T: Real> Monitor<T> {
         }
         // Accepted: the run of identical readings goes on, or starts with this one.
         last.tick = x.tick;
-        last.alpha_rad = x.alpha_rad;
-        last.alpha_rate_radps = x.alpha_rate_radps;
-        Ok(())
+        last.alpha_rad = alpha_rad;
+        last.alpha_rate_radps = alpha_rate_radps;
+        Ok((alpha_rad, alpha_rate_radps))
     }
 }
 
@@ -197,9 +213,12 @@ mod tests {
         Input {
             tick,
             length_m: 1_000.0,
-            alpha_rad,
-            alpha_rate_radps,
+            reel_rate_mps: None,
+            tension_n: None,
+            alpha_rad: Some(alpha_rad),
+            alpha_rate_radps: Some(alpha_rate_radps),
             orbit_rate_radps: 1.06e-3,
+            true_anomaly_rad: 0.0,
         }
     }
 
@@ -208,17 +227,29 @@ mod tests {
         let cfg = MonitorConfig::<f64>::default_for_period();
         let mut m = Monitor::new(42_000.0).unwrap();
         // No previous sample: any α in range is accepted.
-        assert_eq!(m.check(&cfg, &sample(5, 3.0, 0.01), None, 1.0), Ok(()));
+        assert_eq!(
+            m.check(&cfg, &sample(5, 3.0, 0.01), None, 1.0).map(drop),
+            Ok(())
+        );
         // Predicted 3.01 one tick later; 0.1 rad allowed.
-        assert_eq!(m.check(&cfg, &sample(6, 3.105, 0.0), None, 1.0), Ok(()));
+        assert_eq!(
+            m.check(&cfg, &sample(6, 3.105, 0.0), None, 1.0).map(drop),
+            Ok(())
+        );
         assert_eq!(
             m.check(&cfg, &sample(7, 2.9, 0.0), None, 1.0),
             Err(Sensor::AlphaJump)
         );
         // Three ticks after the last accepted one (tick 6): 0.3 rad allowed.
-        assert_eq!(m.check(&cfg, &sample(9, 2.85, 0.0), None, 1.0), Ok(()));
+        assert_eq!(
+            m.check(&cfg, &sample(9, 2.85, 0.0), None, 1.0).map(drop),
+            Ok(())
+        );
         // The same tick again: one tick's allowance, no motion predicted.
-        assert_eq!(m.check(&cfg, &sample(9, 2.93, 0.0), None, 1.0), Ok(()));
+        assert_eq!(
+            m.check(&cfg, &sample(9, 2.93, 0.0), None, 1.0).map(drop),
+            Ok(())
+        );
         assert_eq!(
             m.check(&cfg, &sample(9, 3.1, 0.0), None, 1.0),
             Err(Sensor::AlphaJump)
@@ -234,11 +265,17 @@ mod tests {
         };
         let mut m = Monitor::new(42_000.0).unwrap();
         // 0.0 rad is not mistaken for a repeat of anything before the first reading.
-        assert_eq!(m.check(&cfg, &sample(0, 0.0, 0.01), None, 1.0), Ok(()));
+        assert_eq!(
+            m.check(&cfg, &sample(0, 0.0, 0.01), None, 1.0).map(drop),
+            Ok(())
+        );
         let last = m.last.unwrap();
         assert_eq!((last.same_alpha_count, last.implied_motion_rad), (1, 0.0));
         // Second identical reading: 2 in a row, 0.01 rad implied (< 0.015): still accepted.
-        assert_eq!(m.check(&cfg, &sample(1, 0.0, 0.01), None, 1.0), Ok(()));
+        assert_eq!(
+            m.check(&cfg, &sample(1, 0.0, 0.01), None, 1.0).map(drop),
+            Ok(())
+        );
         assert_eq!(
             m.check(&cfg, &sample(2, 0.0, 0.01), None, 1.0),
             Err(Sensor::AlphaStuck)
@@ -251,9 +288,12 @@ mod tests {
         let ok = Input {
             tick: 0,
             length_m: 1_000.0_f32,
-            alpha_rad: 0.5,
-            alpha_rate_radps: 1e-4,
+            reel_rate_mps: None,
+            tension_n: None,
+            alpha_rad: Some(0.5),
+            alpha_rate_radps: Some(1e-4),
             orbit_rate_radps: 1.06e-3,
+            true_anomaly_rad: 0.0,
         };
         let pi = core::f32::consts::PI;
         let cases = [
@@ -287,35 +327,49 @@ mod tests {
             ),
             (
                 Input {
-                    alpha_rad: pi.next_up(),
+                    alpha_rad: Some(pi.next_up()),
                     ..ok
                 },
                 Sensor::Alpha,
             ),
             (
                 Input {
-                    alpha_rad: f32::NEG_INFINITY,
+                    alpha_rad: Some(f32::NEG_INFINITY),
                     ..ok
                 },
                 Sensor::Alpha,
             ),
             (
                 Input {
-                    alpha_rad: -f32::NAN,
+                    alpha_rad: Some(-f32::NAN),
                     ..ok
                 },
                 Sensor::Alpha,
             ),
             (
                 Input {
-                    alpha_rate_radps: 0.0601,
+                    alpha_rate_radps: Some(0.0601),
                     ..ok
                 },
                 Sensor::AlphaRate,
             ),
             (
                 Input {
-                    alpha_rate_radps: f32::NAN,
+                    alpha_rate_radps: Some(f32::NAN),
+                    ..ok
+                },
+                Sensor::AlphaRate,
+            ),
+            (
+                Input {
+                    alpha_rad: None,
+                    ..ok
+                },
+                Sensor::Alpha,
+            ),
+            (
+                Input {
+                    alpha_rate_radps: None,
                     ..ok
                 },
                 Sensor::AlphaRate,
@@ -342,7 +396,7 @@ mod tests {
         for x in [
             ok,
             Input {
-                alpha_rad: -pi,
+                alpha_rad: Some(-pi),
                 ..ok
             },
             Input {
@@ -355,7 +409,7 @@ mod tests {
             },
         ] {
             let mut m = Monitor::new(42_000.0_f32).unwrap();
-            assert_eq!(m.check(&cfg, &x, None, 1.0), Ok(()), "{x:?}");
+            assert_eq!(m.check(&cfg, &x, None, 1.0).map(drop), Ok(()), "{x:?}");
         }
     }
 }

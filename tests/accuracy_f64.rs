@@ -55,9 +55,12 @@ fn to_f64(x: &Input<f32>) -> Input<f64> {
     Input {
         tick: x.tick,
         length_m: f64::from(x.length_m),
-        alpha_rad: f64::from(x.alpha_rad),
-        alpha_rate_radps: f64::from(x.alpha_rate_radps),
+        reel_rate_mps: None,
+        tension_n: None,
+        alpha_rad: x.alpha_rad.map(f64::from),
+        alpha_rate_radps: x.alpha_rate_radps.map(f64::from),
         orbit_rate_radps: f64::from(x.orbit_rate_radps),
+        true_anomaly_rad: 0.0,
     }
 }
 
@@ -139,12 +142,13 @@ impl Figures {
 
 /// Effect on the f64 command of moving α by half an f32 spacing, from `c64`'s state.
 fn input_rounding(c64: &Controller<f64>, x: &Input<f64>, y64: f64) -> f64 {
-    let h = half_ulp(x.alpha_rad as f32);
+    let alpha = x.alpha_rad.expect("the comparison flies on sensed α");
+    let h = half_ulp(alpha as f32);
     [h, -h]
         .iter()
         .map(|d| {
             let out = c64.clone().step(&Input {
-                alpha_rad: x.alpha_rad + d,
+                alpha_rad: Some(alpha + d),
                 ..*x
             });
             (out.rate_cmd_mps - y64).abs() / y64.abs().max(RATE_FLOOR_MPS)
@@ -171,9 +175,12 @@ fn compare(ticks: u32, orbit_rate_radps: f32, sample: impl Fn(u32) -> Option<[f3
         let input = sample(tick).map(|s| Input {
             tick,
             length_m: s[0],
-            alpha_rad: s[1],
-            alpha_rate_radps: s[2],
+            reel_rate_mps: None,
+            tension_n: None,
+            alpha_rad: Some(s[1]),
+            alpha_rate_radps: Some(s[2]),
             orbit_rate_radps,
+            true_anomaly_rad: 0.0,
         });
         let (o32, o64, sens) = match &input {
             Some(x) => {
@@ -308,16 +315,22 @@ fn random_states_f32_vs_f64() {
         let first = Input {
             tick: 0,
             length_m: l0,
-            alpha_rad: alpha,
-            alpha_rate_radps: 0.0,
+            reel_rate_mps: None,
+            tension_n: None,
+            alpha_rad: Some(alpha),
+            alpha_rate_radps: Some(0.0),
             orbit_rate_radps: n,
+            true_anomaly_rad: 0.0,
         };
         let x = Input {
             tick: k,
             length_m: l,
-            alpha_rad: alpha,
-            alpha_rate_radps: alpha_rate,
+            reel_rate_mps: None,
+            tension_n: None,
+            alpha_rad: Some(alpha),
+            alpha_rate_radps: Some(alpha_rate),
             orbit_rate_radps: n,
+            true_anomaly_rad: 0.0,
         };
         let mut c32 = Controller::new(Config::<f32>::paper()).unwrap();
         let mut c64 = Controller::new(Config::<f64>::paper()).unwrap();

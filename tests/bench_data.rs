@@ -134,9 +134,12 @@ fn interpolated_mission_flies_every_phase_nominally() {
         let out = ctl.step(&Input {
             tick,
             length_m: s[0],
-            alpha_rad: s[1],
-            alpha_rate_radps: s[2],
+            reel_rate_mps: None,
+            tension_n: None,
+            alpha_rad: Some(s[1]),
+            alpha_rate_radps: Some(s[2]),
             orbit_rate_radps: mission::ORBIT_RATE_RADPS,
+            true_anomaly_rad: 0.0,
         });
         assert!(
             out.fault.is_none() && out.health == Health::Nominal,

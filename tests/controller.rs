@@ -17,9 +17,12 @@ fn sample(tick: u32, length_m: f32) -> Input<f32> {
     Input {
         tick,
         length_m,
-        alpha_rad: -0.7,
-        alpha_rate_radps: 0.0,
+        reel_rate_mps: None,
+        tension_n: None,
+        alpha_rad: Some(-0.7),
+        alpha_rate_radps: Some(0.0),
         orbit_rate_radps: N_RADPS,
+        true_anomaly_rad: 0.0,
     }
 }
 
@@ -214,7 +217,7 @@ fn stuck_angle_sensor_is_detected() {
     for t in 0..40 {
         // α frozen at −0.7 while α̇ claims 1e-4 rad/s.
         let o = ctl.step(&Input {
-            alpha_rate_radps: 1e-4,
+            alpha_rate_radps: Some(1e-4),
             ..sample(t, 100.0 + t as f32 * 0.1)
         });
         if let Some(f) = o.fault {
@@ -246,14 +249,14 @@ fn non_finite_and_out_of_range_samples_are_typed() {
         ),
         (
             Input {
-                alpha_rad: f32::INFINITY,
+                alpha_rad: Some(f32::INFINITY),
                 ..sample(1, 1.0)
             },
             Sensor::Alpha,
         ),
         (
             Input {
-                alpha_rate_radps: 1.0,
+                alpha_rate_radps: Some(1.0),
                 ..sample(1, 1.0)
             },
             Sensor::AlphaRate,
@@ -294,7 +297,7 @@ fn singular_law_is_a_fault_and_the_reel_coasts() {
     let mut ctl = paper();
     ctl.step(&sample(0, 100.0));
     let o = ctl.step(&Input {
-        alpha_rate_radps: -N_RADPS,
+        alpha_rate_radps: Some(-N_RADPS),
         ..sample(1, 100.1)
     });
     assert_eq!(o.fault, Some(Fault::Law(LawFault::SingularDenominator)));
@@ -314,13 +317,13 @@ fn stage2_starts_on_command_and_restarts_the_blend_from_the_current_rate() {
     let mut ctl = Controller::new(cfg).unwrap();
     let mut l = 29_999.0;
     let mut o = ctl.step(&Input {
-        alpha_rad: 0.0,
+        alpha_rad: Some(0.0),
         ..sample(0, l)
     });
     for t in 1..100 {
         l += o.rate_cmd_mps;
         o = ctl.step(&Input {
-            alpha_rad: 0.0,
+            alpha_rad: Some(0.0),
             ..sample(t, l)
         });
     }
@@ -328,7 +331,7 @@ fn stage2_starts_on_command_and_restarts_the_blend_from_the_current_rate() {
     let before = o.rate_cmd_mps;
     ctl.start_stage2();
     let s = ctl.step(&Input {
-        alpha_rad: 0.0,
+        alpha_rad: Some(0.0),
         ..sample(100, l + before)
     });
     assert_eq!(s.phase, Phase::Slew);
@@ -350,13 +353,13 @@ fn early_deployment_is_flagged_outside_the_equilibrium_region() {
     // Station keeping at 30 km is inside with margin ≈ 1.5.
     let mut ctl = paper();
     let o = ctl.step(&Input {
-        alpha_rad: 0.0,
+        alpha_rad: Some(0.0),
         ..sample(0, 30_000.0)
     });
     let mut o2 = o;
     for t in 1..5000 {
         o2 = ctl.step(&Input {
-            alpha_rad: 0.0,
+            alpha_rad: Some(0.0),
             ..sample(t, 30_000.0)
         });
     }
@@ -567,7 +570,7 @@ fn the_commanded_acceleration_stays_inside_the_envelope_at_a_blend_start() {
     cfg.envelope.max_rate_mps = 10.0;
     let mut ctl = Controller::new(cfg).unwrap();
     let o = ctl.step(&Input {
-        alpha_rate_radps: -0.98 * N_RADPS,
+        alpha_rate_radps: Some(-0.98 * N_RADPS),
         ..sample(0, 2_000.0)
     });
     assert_eq!(o.health, Health::Nominal, "{o:?}");
@@ -590,7 +593,7 @@ fn an_intermittent_sensor_reaches_safe_hold() {
             l += out.rate_cmd_mps;
             let alpha_rad = if k < 20 { f32::NAN } else { -0.7 };
             out = ctl.step(&Input {
-                alpha_rad,
+                alpha_rad: Some(alpha_rad),
                 ..sample(tick, l)
             });
             if out.health == Health::SafeHold && held_at.is_none() {
@@ -607,7 +610,7 @@ fn an_intermittent_sensor_reaches_safe_hold() {
         l += out.rate_cmd_mps;
         let alpha_rad = if tick % 10 == 0 { f32::NAN } else { -0.7 };
         out = ctl.step(&Input {
-            alpha_rad,
+            alpha_rad: Some(alpha_rad),
             ..sample(tick, l)
         });
         assert_ne!(out.health, Health::SafeHold, "tick {tick}");
@@ -635,13 +638,13 @@ fn a_deployment_that_stops_progressing_is_reported() {
     let mut l = 2_000.0_f32;
     let mut first = None;
     let mut out = ctl.step(&Input {
-        alpha_rad,
+        alpha_rad: Some(alpha_rad),
         ..sample(0, l)
     });
     for tick in 1..20_000 {
         l += out.rate_cmd_mps;
         out = ctl.step(&Input {
-            alpha_rad,
+            alpha_rad: Some(alpha_rad),
             ..sample(tick, l)
         });
         assert_eq!((out.health, out.phase), (Health::Nominal, Phase::Deploy));
@@ -662,4 +665,65 @@ fn a_deployment_that_stops_progressing_is_reported() {
     assert_eq!(stalls[0].kind, EventKind::NoProgress(Phase::Deploy));
     assert_eq!(stalls[0].tick, first);
     assert!(out.flags.contains(Flags::NO_PROGRESS), "still reported");
+}
+
+#[test]
+fn estimator_parameters_are_named_by_their_path_in_the_config() {
+    use tss_reel::controller::RateSource;
+    use tss_reel::estimator;
+    let with = |est: estimator::Config<f32>| Config {
+        rate_source: RateSource::Estimator(est),
+        ..Config::<f32>::paper()
+    };
+    assert!(with(estimator::Config::paper()).validate().is_ok());
+    let mut est = estimator::Config::paper();
+    est.alpha_noise_rad = -1.0;
+    assert_eq!(
+        rejected(with(est)),
+        ("rate_source.estimator.alpha_noise_rad", Rule::OutOfRange)
+    );
+    est.alpha_noise_rad = f32::NAN;
+    assert_eq!(
+        rejected(with(est)),
+        ("rate_source.estimator.alpha_noise_rad", Rule::NotFinite)
+    );
+    let mut est = estimator::Config::paper();
+    est.max_rejections = 0;
+    assert_eq!(
+        rejected(with(est)),
+        ("rate_source.estimator.max_rejections", Rule::OutOfRange)
+    );
+    // The estimator steps once per control period: its period is the controller's.
+    let mut est = estimator::Config::paper();
+    est.period_s = 2.0;
+    assert_eq!(
+        rejected(with(est)),
+        ("rate_source.estimator.period_s", Rule::NotThePeriod)
+    );
+}
+
+#[test]
+fn on_the_rate_sensor_a_sample_without_alpha_or_its_rate_is_rejected() {
+    for (x, sensor) in [
+        (
+            Input {
+                alpha_rad: None,
+                ..sample(1, 1.0)
+            },
+            Sensor::Alpha,
+        ),
+        (
+            Input {
+                alpha_rate_radps: None,
+                ..sample(1, 1.0)
+            },
+            Sensor::AlphaRate,
+        ),
+    ] {
+        let mut ctl = paper();
+        ctl.step(&sample(0, 1.0));
+        let o = ctl.step(&x);
+        assert_eq!(o.fault, Some(Fault::Sensor(sensor)));
+        assert_eq!(o.health, Health::Degraded);
+    }
 }

@@ -171,9 +171,12 @@ fn fly_scenario(sc: &Scenario, duration_s: f64, process: Option<(&Config<f64>, u
         let input = Input {
             tick,
             length_m: x[ix::LENGTH] as f32,
-            alpha_rad: x[ix::ALPHA] as f32,
-            alpha_rate_radps: x[ix::ALPHA_RATE] as f32,
+            reel_rate_mps: None,
+            tension_n: None,
+            alpha_rad: Some(x[ix::ALPHA] as f32),
+            alpha_rate_radps: Some(x[ix::ALPHA_RATE] as f32),
             orbit_rate_radps: orbit_rate as f32,
+            true_anomaly_rad: 0.0,
         };
         let out = Stepper::step(&mut ctl, tick, Some(&input)).expect("controller steps");
         let rate = f64::from(out.rate_cmd_mps);
@@ -1190,9 +1193,12 @@ fn the_law_flies_the_mission_on_the_estimate_with_a_taut_tether() {
             let input = Input {
                 tick,
                 length_m: x[ix::LENGTH] as f32,
-                alpha_rad: alpha,
-                alpha_rate_radps: rate,
+                reel_rate_mps: None,
+                tension_n: None,
+                alpha_rad: Some(alpha),
+                alpha_rate_radps: Some(rate),
                 orbit_rate_radps: N as f32,
+                true_anomaly_rad: 0.0,
             };
             let out = Stepper::step(&mut ctl, tick, Some(&input)).expect("steps");
             let (rate, accel) = (f64::from(out.rate_cmd_mps), f64::from(out.accel_cmd_mps2));

@@ -110,9 +110,12 @@ fn host_commands() -> (Vec<f32>, u32) {
                 ctl.step(&Input {
                     tick,
                     length_m: s[0],
-                    alpha_rad: s[1],
-                    alpha_rate_radps: s[2],
+                    reel_rate_mps: None,
+                    tension_n: None,
+                    alpha_rad: Some(s[1]),
+                    alpha_rate_radps: Some(s[2]),
                     orbit_rate_radps: replay_data::ORBIT_RATE_RADPS,
+                    true_anomaly_rad: 0.0,
                 })
             };
         digest = fnv1a(digest, out.rate_cmd_mps.to_bits());

@@ -237,9 +237,12 @@ mod tests {
                 let o = ctl.step(&Input {
                     tick,
                     length_m: a,
-                    alpha_rad: b,
-                    alpha_rate_radps: a,
+                    reel_rate_mps: None,
+                    tension_n: None,
+                    alpha_rad: Some(b),
+                    alpha_rate_radps: Some(a),
                     orbit_rate_radps: b,
+                    true_anomaly_rad: 0.0,
                 });
                 defmt::assert!(o.rate_cmd_mps.is_finite());
                 defmt::assert!(o.rate_cmd_mps.abs() <= cfg.envelope.max_rate_mps);

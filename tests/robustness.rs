@@ -126,9 +126,12 @@ fn fly(start: u32, events: Vec<Event>) {
                 ctl.step(&Input {
                     tick,
                     length_m,
-                    alpha_rad,
-                    alpha_rate_radps,
+                    reel_rate_mps: None,
+                    tension_n: None,
+                    alpha_rad: Some(alpha_rad),
+                    alpha_rate_radps: Some(alpha_rate_radps),
                     orbit_rate_radps,
+                    true_anomaly_rad: 0.0,
                 })
             }
             Event::Missing { gap } => {
@@ -205,9 +208,12 @@ proptest! {
             let out = ctl.step(&Input {
                 tick: tick as u32,
                 length_m: l as f32,
-                alpha_rad: alpha,
-                alpha_rate_radps: rate,
+                reel_rate_mps: None,
+                tension_n: None,
+                alpha_rad: Some(alpha),
+                alpha_rate_radps: Some(rate),
                 orbit_rate_radps: 1.06e-3,
+                true_anomaly_rad: 0.0,
             });
             l += f64::from(out.rate_cmd_mps);
             prop_assert!(l >= f64::from(env.min_length_m) - 1e-3 && l <= f64::from(env.max_length_m) + 1e-2,

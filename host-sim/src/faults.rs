@@ -214,12 +214,38 @@ impl InjectionPlan {
 pub struct Truth {
     /// Tether length, m.
     pub length_m: f64,
+    /// The drum's actual rate over the last period (its length change over the period), m/s.
+    pub reel_rate_mps: f64,
+    /// Tension at the reel at the end of the last period, under the command held over it, N.
+    pub tension_n: f64,
     /// α, rad.
     pub alpha_rad: f64,
     /// α̇, rad/s.
     pub alpha_rate_radps: f64,
     /// Orbit rate θ̇, rad/s.
     pub orbit_rate_radps: f64,
+    /// True anomaly θ, rad.
+    pub true_anomaly_rad: f64,
+}
+
+/// What the controller reads at one tick: the fields of its `Input`, in f64, with the same
+/// options (`None`: that sensor gave nothing this period).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Reading {
+    /// Length from the reel encoder, m.
+    pub length_m: f64,
+    /// The reel's rate from its encoder, m/s.
+    pub reel_rate_mps: Option<f64>,
+    /// Tension at the reel from the load cell, N.
+    pub tension_n: Option<f64>,
+    /// α from the swing sensor, rad.
+    pub alpha_rad: Option<f64>,
+    /// α̇ from the optional rate sensor, rad/s.
+    pub alpha_rate_radps: Option<f64>,
+    /// Orbit rate θ̇, rad/s.
+    pub orbit_rate_radps: f64,
+    /// True anomaly θ, rad.
+    pub true_anomaly_rad: f64,
 }
 
 /// One sensor: bias, noise, quantisation, stuck window.
@@ -270,7 +296,7 @@ impl Channel {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Sensed {
     /// A sample (possibly wrong: noisy, biased, stuck, corrupted, glitched).
-    Sample(Truth),
+    Sample(Reading),
     /// No sample arrived (a `[[faults.dropout]]` window).
     Missing,
 }
@@ -307,11 +333,14 @@ impl Injector {
 
     /// What the controller reads at `tick` (mission time `t_s`).
     pub fn sense(&mut self, tick: u32, t_s: f64, truth: &Truth) -> Sensed {
-        let mut r = Truth {
+        let mut r = Reading {
             length_m: self.length.read(truth.length_m, t_s),
-            alpha_rad: self.alpha.read(truth.alpha_rad, t_s),
-            alpha_rate_radps: self.alpha_rate.read(truth.alpha_rate_radps, t_s),
+            reel_rate_mps: Some(truth.reel_rate_mps),
+            tension_n: Some(truth.tension_n),
+            alpha_rad: Some(self.alpha.read(truth.alpha_rad, t_s)),
+            alpha_rate_radps: Some(self.alpha_rate.read(truth.alpha_rate_radps, t_s)),
             orbit_rate_radps: truth.orbit_rate_radps,
+            true_anomaly_rad: truth.true_anomaly_rad,
         };
         if self.dropout.iter().any(|w| w.contains(t_s)) {
             return Sensed::Missing;
@@ -325,8 +354,8 @@ impl Injector {
             if c.window.contains(t_s) {
                 match c.sensor {
                     SensedQuantity::Length => r.length_m = c.value,
-                    SensedQuantity::Alpha => r.alpha_rad = c.value,
-                    SensedQuantity::AlphaRate => r.alpha_rate_radps = c.value,
+                    SensedQuantity::Alpha => r.alpha_rad = Some(c.value),
+                    SensedQuantity::AlphaRate => r.alpha_rate_radps = Some(c.value),
                     SensedQuantity::OrbitRate => r.orbit_rate_radps = c.value,
                     SensedQuantity::ReelRate | SensedQuantity::Tension => {}
                 }

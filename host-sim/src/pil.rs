@@ -540,8 +540,10 @@ impl PilLink {
                 tick,
                 status: SAMPLE_VALID,
                 length_m: x.length_m,
-                alpha_rad: x.alpha_rad,
-                alpha_rate_radps: x.alpha_rate_radps,
+                // This wire format has no α or α̇ absent: NaN, which the firmware's monitor
+                // rejects as it rejects a missing one.
+                alpha_rad: x.alpha_rad.unwrap_or(f32::NAN),
+                alpha_rate_radps: x.alpha_rate_radps.unwrap_or(f32::NAN),
                 orbit_rate_radps: x.orbit_rate_radps,
             },
             None => Sample {

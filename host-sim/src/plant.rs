@@ -266,6 +266,8 @@ pub struct SensorTruth {
     pub alpha_rate_radps: f64,
     /// Orbit rate θ̇, rad/s.
     pub orbit_rate_radps: f64,
+    /// True anomaly θ, rad.
+    pub true_anomaly_rad: f64,
 }
 
 /// What the elastic plant adds to a recorded instant.
@@ -375,6 +377,7 @@ impl Plant for RigidPlant {
                 alpha_rad: x[ix::ALPHA],
                 alpha_rate_radps: x[ix::ALPHA_RATE],
                 orbit_rate_radps: self.model.orbit_rate_radps(x[ix::THETA]),
+                true_anomaly_rad: x[ix::THETA].rem_euclid(std::f64::consts::TAU),
             },
             length_m: x[ix::LENGTH],
             alpha_rad: x[ix::ALPHA],

@@ -10,7 +10,7 @@
 //! feeds the fault summary (`History::faults`).
 
 use crate::elastic::{ElasticError, ElasticParams, ElasticPlant, InitialConditions};
-use crate::faults::{InjectionPlan, Injector, Sensed, SummaryBuilder, TickRecord, Truth};
+use crate::faults::{InjectionPlan, Injector, Reading, Sensed, SummaryBuilder, TickRecord, Truth};
 use crate::history::{History, PhaseLabel, Sample};
 use crate::plant::{ix, Command, Observation, Plant, RigidModel, RigidPlant, State};
 use crate::reel::{Reel, ReelDrive};
@@ -186,30 +186,34 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
     let mut injector = Injector::new(&InjectionPlan::from(sc), period);
     let mut summary = SummaryBuilder::new(period, &sc.envelope.to_envelope());
     let mut next_probe = 0;
+    // The command held over the last period (before the first: the release rate), and the
+    // encoder's length at the start of it: the reel's truth at the end of the period.
+    let mut held = Command {
+        rate_mps: sc.initial.length_rate_mps,
+        accel_mps2: 0.0,
+    };
+    let mut last_length_m: Option<f64> = None;
     for tick in 0..=total {
         let t_s = f64::from(tick) * period;
         if !plant.is_finite() {
             return Err(SimError::Diverged { t_s });
         }
-        let seen = plant.observe(&Command::default()).sensors;
+        let now = plant.observe(&held);
+        let seen = now.sensors;
         let truth = Truth {
             length_m: seen.length_m,
+            reel_rate_mps: last_length_m
+                .map_or(sc.initial.length_rate_mps, |l| (seen.length_m - l) / period),
+            tension_n: now.tension_n,
             alpha_rad: seen.alpha_rad,
             alpha_rate_radps: seen.alpha_rate_radps,
             orbit_rate_radps: seen.orbit_rate_radps,
+            true_anomaly_rad: seen.true_anomaly_rad,
         };
+        last_length_m = Some(seen.length_m);
         let sensed = injector.sense(tick, t_s, &truth);
         let out = match sensed {
-            Sensed::Sample(r) => stepper.step(
-                tick,
-                Some(&Input {
-                    tick,
-                    length_m: T::from_f64(r.length_m),
-                    alpha_rad: T::from_f64(r.alpha_rad),
-                    alpha_rate_radps: T::from_f64(r.alpha_rate_radps),
-                    orbit_rate_radps: T::from_f64(r.orbit_rate_radps),
-                }),
-            )?,
+            Sensed::Sample(r) => stepper.step(tick, Some(&input(tick, &r)))?,
             Sensed::Missing => stepper.step(tick, None)?,
         };
         let command = Command {
@@ -252,9 +256,24 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
             break;
         }
         plant.step(&command, period);
+        held = command;
     }
     history.faults = summary.finish();
     Ok(history)
+}
+
+/// The controller's input of a reading, field by field.
+fn input<T: Real>(tick: u32, r: &Reading) -> Input<T> {
+    Input {
+        tick,
+        length_m: T::from_f64(r.length_m),
+        reel_rate_mps: r.reel_rate_mps.map(T::from_f64),
+        tension_n: r.tension_n.map(T::from_f64),
+        alpha_rad: r.alpha_rad.map(T::from_f64),
+        alpha_rate_radps: r.alpha_rate_radps.map(T::from_f64),
+        orbit_rate_radps: T::from_f64(r.orbit_rate_radps),
+        true_anomaly_rad: T::from_f64(r.true_anomaly_rad),
+    }
 }
 
 /// The elastic plant's initial conditions: the rigid plant's (straight at l(0), along

@@ -325,9 +325,12 @@ fn fly_elastic(sc: &Scenario, prm: ElasticParams) -> Flight {
         let out = ctl.step(&Input {
             tick,
             length_m: m.paid_out_m as f32,
-            alpha_rad: a.alpha_rad as f32,
-            alpha_rate_radps: a.alpha_rate_radps as f32,
+            reel_rate_mps: None,
+            tension_n: None,
+            alpha_rad: Some(a.alpha_rad as f32),
+            alpha_rate_radps: Some(a.alpha_rate_radps as f32),
             orbit_rate_radps: m.orbit_rate_radps as f32,
+            true_anomaly_rad: 0.0,
         });
         let (rate, now) = (f64::from(out.rate_cmd_mps), out.phase);
         if phase != Some(now) {

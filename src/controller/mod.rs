@@ -11,9 +11,12 @@
 //! let out = ctl.step(&Input {
 //!     tick: 0,
 //!     length_m: 1.0,
-//!     alpha_rad: -35.0_f32.to_radians(),
-//!     alpha_rate_radps: 0.0,
+//!     reel_rate_mps: None,
+//!     tension_n: None,
+//!     alpha_rad: Some(-35.0_f32.to_radians()),
+//!     alpha_rate_radps: Some(0.0),
 //!     orbit_rate_radps: 1.0602e-3,
+//!     true_anomaly_rad: 0.0,
 //! });
 //! // The output is a value: the controller can be used again while it is read.
 //! while let Some(event) = ctl.pop_event() {
@@ -46,7 +49,9 @@ use crate::law::{self, LawInput};
 use crate::monitor::{Monitor, SPOOL_MARGIN};
 use crate::real::Real;
 
-pub use crate::config::{Config, ConfigError, MonitorConfig, Rule, Stage1Config, Stage2Config};
+pub use crate::config::{
+    Config, ConfigError, MonitorConfig, RateSource, Rule, Stage1Config, Stage2Config,
+};
 pub use crate::envelope::Envelope;
 pub use crate::monitor::{Input, Sensor};
 pub use events::{Event, EventKind, EVENT_CAPACITY};
@@ -234,9 +239,11 @@ impl<T: Real> Controller<T> {
             Health::SafeHold => None,
             Health::Nominal | Health::Degraded => predicted_m,
         };
-        if let Err(s) = self.monitor.check(&self.cfg.monitor, x, expected, dt) {
-            return self.reject(tick, predicted_m, Fault::Sensor(s), None, flags);
-        }
+        let (alpha_rad, alpha_rate_radps) =
+            match self.monitor.check(&self.cfg.monitor, x, expected, dt) {
+                Ok(angles) => angles,
+                Err(s) => return self.reject(tick, predicted_m, Fault::Sensor(s), None, flags),
+            };
         self.length.sensed(x.length_m);
 
         let reference = self.sequencer.reference(tick, x.length_m);
@@ -253,8 +260,8 @@ impl<T: Real> Controller<T> {
         let (mu3, mu3_per_m) = self.cfg.masses.mu3_and_slope(x.length_m);
         let law_in = LawInput {
             length_m: x.length_m,
-            alpha_rad: x.alpha_rad,
-            alpha_rate_radps: x.alpha_rate_radps,
+            alpha_rad,
+            alpha_rate_radps,
             orbit_rate_radps: x.orbit_rate_radps,
             ref_angle_rad: reference.angle.angle_rad,
             ref_slope_rad_per_m: reference.angle.slope_rad_per_m,

@@ -139,9 +139,12 @@ mod tests {
                 direct.step(&Input {
                     tick,
                     length_m: s[0],
-                    alpha_rad: s[1],
-                    alpha_rate_radps: s[2],
+                    reel_rate_mps: None,
+                    tension_n: None,
+                    alpha_rad: Some(s[1]),
+                    alpha_rate_radps: Some(s[2]),
                     orbit_rate_radps: ORBIT_RATE_RADPS,
+                    true_anomaly_rad: 0.0,
                 })
             };
             let sent = dev.reel.0.take().expect("a command every tick");

@@ -407,6 +407,9 @@ pub struct Measurement {
     pub exit: Angles,
     /// The centre of mass's orbit rate θ̇, rad/s.
     pub orbit_rate_radps: f64,
+    /// The centre of mass's true anomaly θ, rad: its angle from the initial orbit's periapsis
+    /// in the initial orbit plane (J2's node regression turns the plane slowly away from it).
+    pub true_anomaly_rad: f64,
     /// Tension at the reel (the reel segment), N.
     pub tension_reel_n: f64,
     /// Tension at the sub-satellite (the last segment), N.
@@ -769,6 +772,10 @@ impl ElasticPlant {
             line: angles(last),
             exit: angles(1),
             orbit_rate_radps: h.norm() / rc.norm_squared(),
+            true_anomaly_rad: {
+                let (p_hat, q_hat) = plane_basis(self.p.orbit.inclination_rad);
+                rc.dot(&q_hat).atan2(rc.dot(&p_hat))
+            },
             tension_reel_n: tension(0),
             tension_tip_n: tension(last - 1),
             range_m: range,
@@ -1207,6 +1214,7 @@ impl Plant for ElasticPlant {
                 alpha_rad: sensed.alpha_rad,
                 alpha_rate_radps: sensed.alpha_rate_radps,
                 orbit_rate_radps: m.orbit_rate_radps,
+                true_anomaly_rad: m.true_anomaly_rad,
             },
             length_m: m.paid_out_m,
             alpha_rad: m.line.alpha_rad,

@@ -3,7 +3,9 @@
 //! fault summary. None of them reads the schema: each takes its own parameters, and the
 //! conversions from the sections live here.
 
-use tss_reel::controller::{Config, Envelope, MonitorConfig, Stage1Config, Stage2Config};
+use tss_reel::controller::{
+    Config, Envelope, MonitorConfig, RateSource, Stage1Config, Stage2Config,
+};
 use tss_reel::law::Gains;
 use tss_reel::mass::MassModel;
 use tss_reel::orbit::Orbit;
@@ -92,6 +94,7 @@ impl Scenario {
             keep_capture_m: f(sc.controller.keep_capture_m),
             envelope: sc.envelope.to_envelope(),
             monitor: sc.monitor.to_monitor_config(),
+            rate_source: RateSource::Sensor,
         }
     }
 
