@@ -17,7 +17,9 @@ use tss_reel::controller::{Envelope, Fault, Flags, Health, Output};
 use tss_reel::Real;
 
 use crate::reel::ReelDrive;
-use crate::sensors::{EncoderModel, LoadCellModel, SwingSensorModel};
+use crate::sensors::{
+    EncoderModel, LoadCell, LoadCellModel, RateSensor, ReelEncoder, SwingSensor, SwingSensorModel,
+};
 
 // ---- a small deterministic generator ---------------------------------------------------------
 
@@ -214,9 +216,9 @@ impl InjectionPlan {
 pub struct Truth {
     /// Tether length, m.
     pub length_m: f64,
-    /// The drum's actual rate over the last period (its length change over the period), m/s.
+    /// The drum's actual rate over the last period, m/s.
     pub reel_rate_mps: f64,
-    /// Tension at the reel at the end of the last period, under the command held over it, N.
+    /// Tension at the reel at the end of the last period (under the command held over it), N.
     pub tension_n: f64,
     /// α, rad.
     pub alpha_rad: f64,
@@ -228,19 +230,18 @@ pub struct Truth {
     pub true_anomaly_rad: f64,
 }
 
-/// What the controller reads at one tick: the fields of its `Input`, in f64, with the same
-/// options (`None`: that sensor gave nothing this period).
+/// What the controller reads at one tick: the `Input` fields in f64, with the same options.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Reading {
     /// Length from the reel encoder, m.
     pub length_m: f64,
-    /// The reel's rate from its encoder, m/s.
+    /// The reel's rate from the encoder, m/s (`None`: not measured this period).
     pub reel_rate_mps: Option<f64>,
-    /// Tension at the reel from the load cell, N.
+    /// Tension from the load cell, N (`None`: no load cell).
     pub tension_n: Option<f64>,
-    /// α from the swing sensor, rad.
+    /// α from the swing sensor, rad (`None`: it gave nothing this period).
     pub alpha_rad: Option<f64>,
-    /// α̇ from the optional rate sensor, rad/s.
+    /// α̇ from the rate sensor, rad/s (`None`: none fitted).
     pub alpha_rate_radps: Option<f64>,
     /// Orbit rate θ̇, rad/s.
     pub orbit_rate_radps: f64,
@@ -295,19 +296,30 @@ impl Channel {
 /// What the controller receives at one tick: a reading of every sensor, or nothing (dropout).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Sensed {
-    /// A sample (possibly wrong: noisy, biased, stuck, corrupted, glitched).
+    /// A sample (possibly wrong: noisy, biased, stuck, corrupted, glitched, or without α).
     Sample(Reading),
     /// No sample arrived (a `[[faults.dropout]]` window).
     Missing,
 }
 
+/// The noise streams of the sensors (`Pcg32` streams of `sensors.seed`): fixed, so that a
+/// sensor's noise does not depend on which other sensors are modelled.
+mod stream {
+    pub const LENGTH: u64 = 1;
+    pub const ALPHA: u64 = 2;
+    pub const ALPHA_RATE: u64 = 3;
+    pub const ALPHA_DROPOUT: u64 = 4;
+    pub const LOAD_CELL: u64 = 5;
+}
+
 /// Applies an [`InjectionPlan`] (a scenario's `[sensors]` and `[faults]`) to the plant's truth,
-/// tick by tick.
+/// tick by tick: the sensor models of [`crate::sensors`], then the injected faults.
 #[derive(Clone, Debug)]
 pub struct Injector {
-    length: Channel,
-    alpha: Channel,
-    alpha_rate: Channel,
+    encoder: ReelEncoder,
+    swing: SwingSensor,
+    rate: RateSensor,
+    load_cell: LoadCell,
     dropout: Vec<Window>,
     corrupt: Vec<Corruption>,
     /// (tick, size) of each length glitch.
@@ -317,10 +329,17 @@ pub struct Injector {
 impl Injector {
     /// The injector of `plan` on control period `period_s`.
     pub fn new(plan: &InjectionPlan, period_s: f64) -> Self {
+        let seed = plan.seed;
         Self {
-            length: Channel::new(&plan.length.errors, plan.seed, 1),
-            alpha: Channel::new(&plan.alpha.errors, plan.seed, 2),
-            alpha_rate: Channel::new(&plan.alpha_rate, plan.seed, 3),
+            encoder: ReelEncoder::new(&plan.length, period_s, seed, stream::LENGTH),
+            swing: SwingSensor::new(&plan.alpha, seed, stream::ALPHA, stream::ALPHA_DROPOUT),
+            rate: RateSensor::new(
+                plan.alpha_rate_enabled,
+                &plan.alpha_rate,
+                seed,
+                stream::ALPHA_RATE,
+            ),
+            load_cell: LoadCell::new(&plan.load_cell, seed, stream::LOAD_CELL),
             dropout: plan.dropout.clone(),
             corrupt: plan.corrupt.clone(),
             glitches: plan
@@ -331,14 +350,16 @@ impl Injector {
         }
     }
 
-    /// What the controller reads at `tick` (mission time `t_s`).
+    /// What the controller reads at `tick` (mission time `t_s`). Every sensor measures every
+    /// tick, a dropout's included (its noise stays tied to time).
     pub fn sense(&mut self, tick: u32, t_s: f64, truth: &Truth) -> Sensed {
+        let encoder = self.encoder.read(truth.length_m, truth.reel_rate_mps, t_s);
         let mut r = Reading {
-            length_m: self.length.read(truth.length_m, t_s),
-            reel_rate_mps: Some(truth.reel_rate_mps),
-            tension_n: Some(truth.tension_n),
-            alpha_rad: Some(self.alpha.read(truth.alpha_rad, t_s)),
-            alpha_rate_radps: Some(self.alpha_rate.read(truth.alpha_rate_radps, t_s)),
+            length_m: encoder.length_m,
+            reel_rate_mps: encoder.rate_mps,
+            tension_n: self.load_cell.read(truth.tension_n, t_s),
+            alpha_rad: self.swing.read(truth.alpha_rad, t_s),
+            alpha_rate_radps: self.rate.read(truth.alpha_rate_radps, t_s),
             orbit_rate_radps: truth.orbit_rate_radps,
             true_anomaly_rad: truth.true_anomaly_rad,
         };
@@ -357,7 +378,8 @@ impl Injector {
                     SensedQuantity::Alpha => r.alpha_rad = Some(c.value),
                     SensedQuantity::AlphaRate => r.alpha_rate_radps = Some(c.value),
                     SensedQuantity::OrbitRate => r.orbit_rate_radps = c.value,
-                    SensedQuantity::ReelRate | SensedQuantity::Tension => {}
+                    SensedQuantity::ReelRate => r.reel_rate_mps = Some(c.value),
+                    SensedQuantity::Tension => r.tension_n = Some(c.value),
                 }
             }
         }
@@ -1070,6 +1092,129 @@ mod tests {
             / f64::from(n))
         .sqrt();
         assert!((rms - 0.01).abs() < 5e-4, "{rms}");
+    }
+
+    fn truth(t_s: f64) -> Truth {
+        Truth {
+            length_m: 100.0 + 2.0 * t_s,
+            reel_rate_mps: 2.0,
+            tension_n: 0.5,
+            alpha_rad: -0.7,
+            alpha_rate_radps: 1e-4,
+            orbit_rate_radps: 1.06e-3,
+            true_anomaly_rad: 1.06e-3 * t_s,
+        }
+    }
+
+    fn sample(s: Sensed) -> Reading {
+        match s {
+            Sensed::Sample(r) => r,
+            Sensed::Missing => panic!("no sample"),
+        }
+    }
+
+    #[test]
+    fn by_default_every_sensor_but_the_rate_sensor_reads_the_truth() {
+        let mut inj = Injector::new(&InjectionPlan::default(), 1.0);
+        let t = truth(3.0);
+        assert_eq!(
+            sample(inj.sense(3, 3.0, &t)),
+            Reading {
+                length_m: t.length_m,
+                reel_rate_mps: Some(2.0),
+                tension_n: Some(0.5),
+                alpha_rad: Some(-0.7),
+                alpha_rate_radps: None,
+                orbit_rate_radps: t.orbit_rate_radps,
+                true_anomaly_rad: t.true_anomaly_rad,
+            }
+        );
+        let mut ideal = Injector::new(
+            &InjectionPlan {
+                alpha_rate_enabled: true,
+                ..InjectionPlan::default()
+            },
+            1.0,
+        );
+        assert_eq!(sample(ideal.sense(3, 3.0, &t)).alpha_rate_radps, Some(1e-4));
+    }
+
+    #[test]
+    fn an_alpha_dropout_keeps_the_sample_and_a_sample_dropout_loses_it() {
+        let window = Window {
+            from_s: 10.0,
+            until_s: 12.0,
+        };
+        let mut inj = Injector::new(
+            &InjectionPlan {
+                alpha: SwingSensorModel {
+                    dropout: vec![window],
+                    ..SwingSensorModel::default()
+                },
+                dropout: vec![Window {
+                    from_s: 20.0,
+                    until_s: 21.0,
+                }],
+                ..InjectionPlan::default()
+            },
+            1.0,
+        );
+        for k in 0..25 {
+            let t_s = f64::from(k);
+            let s = inj.sense(k, t_s, &truth(t_s));
+            match k {
+                10 | 11 => {
+                    let r = sample(s);
+                    assert_eq!(r.alpha_rad, None);
+                    assert_eq!(r.length_m, truth(t_s).length_m);
+                }
+                20 => assert_eq!(s, Sensed::Missing),
+                _ => assert_eq!(sample(s).alpha_rad, Some(-0.7)),
+            }
+        }
+    }
+
+    #[test]
+    fn the_encoder_s_rate_is_its_count_difference_and_corruptions_reach_every_reading() {
+        let mut inj = Injector::new(
+            &InjectionPlan {
+                length: EncoderModel {
+                    counts_per_rev: 1000,
+                    drum_radius_m: 0.1,
+                    ..EncoderModel::default()
+                },
+                corrupt: vec![
+                    Corruption {
+                        sensor: SensedQuantity::Tension,
+                        window: Window {
+                            from_s: 2.0,
+                            until_s: 3.0,
+                        },
+                        value: f64::NAN,
+                    },
+                    Corruption {
+                        sensor: SensedQuantity::ReelRate,
+                        window: Window {
+                            from_s: 2.0,
+                            until_s: 3.0,
+                        },
+                        value: 99.0,
+                    },
+                ],
+                ..InjectionPlan::default()
+            },
+            1.0,
+        );
+        let q = std::f64::consts::TAU * 0.1 / 1000.0;
+        let first = sample(inj.sense(0, 0.0, &truth(0.0)));
+        assert_eq!(first.reel_rate_mps, None);
+        assert_eq!(first.length_m, (100.0 / q).floor() * q);
+        let second = sample(inj.sense(1, 1.0, &truth(1.0)));
+        let counts = (102.0 / q).floor() - (100.0 / q).floor();
+        assert_eq!(second.reel_rate_mps, Some(counts * q));
+        let third = sample(inj.sense(2, 2.0, &truth(2.0)));
+        assert!(third.tension_n.is_some_and(f64::is_nan));
+        assert_eq!(third.reel_rate_mps, Some(99.0));
     }
 
     #[test]

@@ -22,6 +22,7 @@ fn summary(extra: &[&str]) -> Summary {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper-montecarlo.toml");
     let mut sets: Vec<String> = [
         "simulation.duration_s=10800",
+        "sensors.alpha_rate.enabled=true",
         "sensors.alpha.noise_std=1e-4",
         "sensors.alpha.bias=0",
         "montecarlo.dispersion=[{ field = \"initial.delta_rad\", distribution = \"normal\", std = 0.0175 }]",

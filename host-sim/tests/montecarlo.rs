@@ -253,7 +253,12 @@ fn an_impossible_criterion_fails_every_run_and_says_which() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("mc");
     let mut args = SHORT.to_vec();
-    args.extend(["--set", "montecarlo.criteria.min_tension_n=1000"]);
+    args.extend([
+        "--set",
+        "montecarlo.criteria.min_tension_n=1000",
+        "--set",
+        "montecarlo.criteria.no_slack=false",
+    ]);
     let o = campaign(&out, 4, 1, &args);
     let summary = read(&out.join("summary.txt"));
     assert!(

@@ -215,12 +215,12 @@ impl<S: Stepper<f32>> Stepper<f32> for Watched<'_, S> {
 
 /// The α the swing sensor delivered with this sample.
 fn alpha(x: &Input<f32>) -> Option<f32> {
-    Some(x.alpha_rad)
+    x.alpha_rad
 }
 
 /// The reel's rate the encoder measured over the last period.
-fn reel_rate(_x: &Input<f32>) -> Option<f32> {
-    None
+fn reel_rate(x: &Input<f32>) -> Option<f32> {
+    x.reel_rate_mps
 }
 
 /// One run's NEES and NIS at each instant k·[`EVERY_S`] (`None`: no estimate, no sample, or

@@ -49,6 +49,17 @@ impl Scenario {
         }
     }
 
+    /// Where the law's α̇ comes from: the α̇ sensor if the scenario fits one
+    /// (`sensors.alpha_rate.enabled`, the paper's idealisation), else the estimator on the
+    /// swing sensor's α ([`Scenario::estimator_config`]), as in flight.
+    pub fn rate_source<T: Real>(&self) -> RateSource<T> {
+        if self.sensors.alpha_rate.enabled {
+            RateSource::Sensor
+        } else {
+            RateSource::Estimator(self.estimator_config())
+        }
+    }
+
     /// The flight controller's configuration, in its scalar type `T` (f32 on the target): the
     /// numbers `Config::validate` judges. The stage-2 start is the nearest control tick.
     pub fn controller_config<T: Real>(&self) -> Config<T> {
@@ -94,7 +105,7 @@ impl Scenario {
             keep_capture_m: f(sc.controller.keep_capture_m),
             envelope: sc.envelope.to_envelope(),
             monitor: sc.monitor.to_monitor_config(),
-            rate_source: RateSource::Sensor,
+            rate_source: sc.rate_source(),
         }
     }
 
