@@ -2,7 +2,7 @@
 
 use rayon::prelude::*;
 
-use tss_reel::controller::Controller;
+use tss_reel::controller::{Controller, Flags};
 
 use super::consistency::{ConsistencySums, RunConsistency, Watched};
 use crate::faults::Pcg32;
@@ -72,11 +72,19 @@ pub enum Metric {
     FaultTicks,
     /// Time in safe hold, s.
     SafeHold,
+    /// Largest |α the law flew − true α| from [`SETTLED_S`] on, rad (sampled, at the steps the
+    /// law ran: not while the controller coasts or holds): the estimate's error on the
+    /// estimator, the sensor's on the α̇ sensor (α_r + δ of the output).
+    AlphaError,
 }
+
+/// The law's α error counts from here, s: 30 min, after the release transient and the
+/// estimator's prior.
+pub const SETTLED_S: f64 = 1_800.0;
 
 impl Metric {
     /// Every metric, in `runs.csv` column order.
-    pub const ALL: [Metric; 13] = [
+    pub const ALL: [Metric; 14] = [
         Metric::TimeToKeep1,
         Metric::Overshoot,
         Metric::Keep1Error,
@@ -90,6 +98,7 @@ impl Metric {
         Metric::Faults,
         Metric::FaultTicks,
         Metric::SafeHold,
+        Metric::AlphaError,
     ];
 
     /// The column name in `runs.csv`.
@@ -108,6 +117,7 @@ impl Metric {
             Metric::Faults => "faults",
             Metric::FaultTicks => "fault_ticks",
             Metric::SafeHold => "safe_hold_s",
+            Metric::AlphaError => "alpha_error_rad",
         }
     }
 
@@ -127,6 +137,7 @@ impl Metric {
             Metric::Faults => "distinct faults raised",
             Metric::FaultTicks => "ticks with a fault",
             Metric::SafeHold => "time in safe hold (s)",
+            Metric::AlphaError => "max |α flown − α| after 30 min (rad)",
         }
     }
 }
@@ -287,6 +298,18 @@ impl Outcome {
             Some(f.faults.iter().map(|t| u64::from(t.ticks)).sum::<u64>() as f64),
         );
         set(Metric::SafeHold, Some(f.safe_hold_s));
+        let alpha_error = h
+            .samples
+            .iter()
+            .filter(|x| x.t_s >= SETTLED_S && x.flags & Flags::SAFE_ACTION == 0)
+            .map(|x| (x.alpha_ref_rad + x.delta_rad - x.alpha_rad).abs())
+            .fold(None, |m: Option<f64>, e| {
+                Some(match m {
+                    Some(m) if m.is_nan() || m >= e => m,
+                    _ => e,
+                })
+            });
+        set(Metric::AlphaError, alpha_error);
         let worst_health = if f.safe_hold_s > 0.0 {
             WorstHealth::SafeHold
         } else if f.degraded_s > 0.0 {
