@@ -210,6 +210,17 @@ impl<T: Real> Config<T> {
         }
     }
 
+    /// The paper's mission ([`Config::paper`]) as it flies: on the onboard estimator's α̂ and α̇̂
+    /// from the swing sensor's α alone ([`RateSource::Estimator`] with
+    /// [`estimator::Config::paper`]: σ_α = 1e-4 rad at 1 s), since no flight sensor measures α̇.
+    /// The flight firmware's configuration.
+    pub fn flight() -> Self {
+        Self {
+            rate_source: RateSource::Estimator(estimator::Config::paper()),
+            ..Self::paper()
+        }
+    }
+
     /// Checks every parameter; the first violation is returned.
     pub fn validate(&self) -> Result<(), ConfigError> {
         let z = T::ZERO;
@@ -373,15 +384,7 @@ pub fn fastest_eq28_pole_per_s<T: Real>(k1_per_s: T, k2_per_s2: T) -> f64 {
 /// The estimator's parameters, its errors mapped to their path in [`Config`]
 /// (`rate_source.estimator.alpha_noise_rad`); its period must be the controller's.
 fn validate_estimator<T: Real>(est: &estimator::Config<T>, period_s: T) -> Result<(), ConfigError> {
-    est.validate().map_err(|e| ConfigError {
-        param: estimator_path(e.param),
-        value: e.value,
-        rule: if e.value.is_finite() {
-            Rule::OutOfRange
-        } else {
-            Rule::NotFinite
-        },
-    })?;
+    est.validate().map_err(estimator_error)?;
     if est.period_s != period_s {
         return Err(ConfigError::new(
             "rate_source.estimator.period_s",
@@ -390,6 +393,19 @@ fn validate_estimator<T: Real>(est: &estimator::Config<T>, period_s: T) -> Resul
         ));
     }
     Ok(())
+}
+
+/// An estimator parameter's error as the controller's: named by its path in [`Config`].
+pub(crate) fn estimator_error(e: estimator::ConfigError) -> ConfigError {
+    ConfigError {
+        param: estimator_path(e.param),
+        value: e.value,
+        rule: if e.value.is_finite() {
+            Rule::OutOfRange
+        } else {
+            Rule::NotFinite
+        },
+    }
 }
 
 /// The path in [`Config`] of an estimator parameter named by [`estimator::ConfigError`].

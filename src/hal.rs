@@ -46,32 +46,34 @@ impl<T: ErrorType + ?Sized> ErrorType for &mut T {
     type Error = T::Error;
 }
 
-/// The reel's length encoder.
+/// The reel's encoder: the paid-out length, and the reel's rate from it.
 pub trait LengthSensor: ErrorType {
     /// The deployed tether length for control period `tick`, m.
     fn read_length_m(&mut self, tick: u32) -> Result<f32, Self::Error>;
+    /// The reel's rate over the period that ended at `tick` (the encoder's count change over
+    /// the period), m/s.
+    fn read_rate_mps(&mut self, tick: u32) -> Result<f32, Self::Error>;
 }
 
-/// One reading of the in-plane swing sensor.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Swing {
-    /// In-plane angle α, rad.
-    pub alpha_rad: f32,
-    /// In-plane rate α̇, rad/s.
-    pub alpha_rate_radps: f32,
-}
-
-/// The tether swing-angle sensor (α and α̇).
+/// The tether swing-angle sensor: the in-plane angle α only (no flight sensor measures α̇;
+/// the controller estimates it, [`crate::estimator`]).
 pub trait SwingSensor: ErrorType {
-    /// α and α̇ for control period `tick`.
-    fn read_swing(&mut self, tick: u32) -> Result<Swing, Self::Error>;
+    /// α for control period `tick`, rad.
+    fn read_alpha_rad(&mut self, tick: u32) -> Result<f32, Self::Error>;
 }
 
-/// The orbit-rate source (navigation), n = θ̇.
+/// The load cell at the reel.
+pub trait TensionSensor: ErrorType {
+    /// The tether tension at the reel for control period `tick`, N.
+    fn read_tension_n(&mut self, tick: u32) -> Result<f32, Self::Error>;
+}
+
+/// The orbit source (navigation): θ̇ and θ.
 pub trait OrbitRateSource: ErrorType {
-    /// The orbit rate for control period `tick`, rad/s.
+    /// The orbit rate θ̇ for control period `tick`, rad/s.
     fn read_orbit_rate_radps(&mut self, tick: u32) -> Result<f32, Self::Error>;
+    /// The true anomaly θ for control period `tick`, rad (used on an eccentric orbit).
+    fn read_true_anomaly_rad(&mut self, tick: u32) -> Result<f32, Self::Error>;
 }
 
 /// The reel drive: takes one command (with its explanation, for telemetry) per period.
@@ -84,17 +86,29 @@ impl<T: LengthSensor + ?Sized> LengthSensor for &mut T {
     fn read_length_m(&mut self, tick: u32) -> Result<f32, Self::Error> {
         T::read_length_m(self, tick)
     }
+    fn read_rate_mps(&mut self, tick: u32) -> Result<f32, Self::Error> {
+        T::read_rate_mps(self, tick)
+    }
 }
 
 impl<T: SwingSensor + ?Sized> SwingSensor for &mut T {
-    fn read_swing(&mut self, tick: u32) -> Result<Swing, Self::Error> {
-        T::read_swing(self, tick)
+    fn read_alpha_rad(&mut self, tick: u32) -> Result<f32, Self::Error> {
+        T::read_alpha_rad(self, tick)
+    }
+}
+
+impl<T: TensionSensor + ?Sized> TensionSensor for &mut T {
+    fn read_tension_n(&mut self, tick: u32) -> Result<f32, Self::Error> {
+        T::read_tension_n(self, tick)
     }
 }
 
 impl<T: OrbitRateSource + ?Sized> OrbitRateSource for &mut T {
     fn read_orbit_rate_radps(&mut self, tick: u32) -> Result<f32, Self::Error> {
         T::read_orbit_rate_radps(self, tick)
+    }
+    fn read_true_anomaly_rad(&mut self, tick: u32) -> Result<f32, Self::Error> {
+        T::read_true_anomaly_rad(self, tick)
     }
 }
 
@@ -106,15 +120,17 @@ impl<T: ReelDrive + ?Sized> ReelDrive for &mut T {
 
 /// The devices of one reel controller.
 #[derive(Debug)]
-pub struct Devices<L, S, O, R> {
+pub struct Devices<L, S, O, R, F> {
     /// Length encoder.
     pub length: L,
     /// Swing sensor.
     pub swing: S,
-    /// Orbit-rate source.
+    /// Orbit source.
     pub orbit: O,
     /// Reel drive.
     pub reel: R,
+    /// Load cell.
+    pub tension: F,
 }
 
 /// What one control cycle did besides stepping the controller (its output, already sent to
@@ -122,53 +138,67 @@ pub struct Devices<L, S, O, R> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Cycle {
-    /// The first sensor error of this period, if any (the controller treated it as a dropout).
+    /// The first error of the length encoder or the orbit source this period, if any: the
+    /// controller stepped without a sample ([`Controller::step_missing`]).
     pub sensor_error: Option<ErrorKind>,
+    /// The first error of the swing sensor, the encoder's rate or the load cell this period, if
+    /// any: the controller stepped without that reading (its [`Input`] field `None`).
+    pub reading_error: Option<ErrorKind>,
     /// The reel drive's error, if it refused the command.
     pub reel_error: Option<ErrorKind>,
 }
 
-/// One control period: read every sensor, step the controller (a failed read is a dropout:
-/// [`Controller::step_missing`]), and send the command to the reel.
-pub fn control_cycle<L, S, O, R>(
+/// One control period: read every sensor, step the controller, and send the command to the
+/// reel. Without a length or an orbit rate there is no sample ([`Controller::step_missing`]);
+/// without α, the encoder's rate or the tension, the sample has that field `None` (flying on
+/// the estimator, a period without α is predicted only). There is no α̇ sensor: a controller
+/// that flies on one ([`crate::config::RateSource::Sensor`]) is not flown through this cycle.
+pub fn control_cycle<L, S, O, R, F>(
     controller: &mut Controller<f32>,
     tick: u32,
-    dev: &mut Devices<L, S, O, R>,
+    dev: &mut Devices<L, S, O, R, F>,
 ) -> Cycle
 where
     L: LengthSensor,
     S: SwingSensor,
     O: OrbitRateSource,
     R: ReelDrive,
+    F: TensionSensor,
 {
     let sample = dev
         .length
         .read_length_m(tick)
         .map_err(|e| e.kind())
         .and_then(|length_m| {
-            let swing = dev.swing.read_swing(tick).map_err(|e| e.kind())?;
-            let n = dev
-                .orbit
-                .read_orbit_rate_radps(tick)
-                .map_err(|e| e.kind())?;
-            Ok(Input {
+            let kind = |e: O::Error| e.kind();
+            let orbit_rate_radps = dev.orbit.read_orbit_rate_radps(tick).map_err(kind)?;
+            let true_anomaly_rad = dev.orbit.read_true_anomaly_rad(tick).map_err(kind)?;
+            Ok((length_m, orbit_rate_radps, true_anomaly_rad))
+        });
+    let (output, sensor_error, reading_error) = match sample {
+        Ok((length_m, orbit_rate_radps, true_anomaly_rad)) => {
+            let alpha = dev.swing.read_alpha_rad(tick).map_err(|e| e.kind());
+            let rate = dev.length.read_rate_mps(tick).map_err(|e| e.kind());
+            let tension = dev.tension.read_tension_n(tick).map_err(|e| e.kind());
+            let reading_error = [alpha, rate, tension].into_iter().find_map(Result::err);
+            let input = Input {
                 tick,
                 length_m,
-                reel_rate_mps: None,
-                tension_n: None,
-                alpha_rad: Some(swing.alpha_rad),
-                alpha_rate_radps: Some(swing.alpha_rate_radps),
-                orbit_rate_radps: n,
-                true_anomaly_rad: 0.0,
-            })
-        });
-    let (output, sensor_error) = match sample {
-        Ok(input) => (controller.step(&input), None),
-        Err(kind) => (controller.step_missing(tick), Some(kind)),
+                reel_rate_mps: rate.ok(),
+                tension_n: tension.ok(),
+                alpha_rad: alpha.ok(),
+                alpha_rate_radps: None,
+                orbit_rate_radps,
+                true_anomaly_rad,
+            };
+            (controller.step(&input), None, reading_error)
+        }
+        Err(kind) => (controller.step_missing(tick), Some(kind), None),
     };
     let reel_error = dev.reel.command(&output).err().map(|e| e.kind());
     Cycle {
         sensor_error,
+        reading_error,
         reel_error,
     }
 }
@@ -177,6 +207,7 @@ where
 mod tests {
     use super::*;
     use crate::controller::{Config, Fault, Health, Sensor};
+    use crate::estimator;
 
     struct Fixed {
         length_m: f32,
@@ -193,18 +224,30 @@ mod tests {
                 Ok(self.length_m)
             }
         }
+        fn read_rate_mps(&mut self, _: u32) -> Result<f32, ErrorKind> {
+            Err(ErrorKind::NoSample)
+        }
     }
     impl SwingSensor for Fixed {
-        fn read_swing(&mut self, _: u32) -> Result<Swing, ErrorKind> {
-            Ok(Swing {
-                alpha_rad: -0.7,
-                alpha_rate_radps: 0.0,
-            })
+        fn read_alpha_rad(&mut self, tick: u32) -> Result<f32, ErrorKind> {
+            if self.fail_at == Some(tick) {
+                Err(ErrorKind::Device)
+            } else {
+                Ok(-0.7)
+            }
+        }
+    }
+    impl TensionSensor for Fixed {
+        fn read_tension_n(&mut self, _: u32) -> Result<f32, ErrorKind> {
+            Ok(1e-3)
         }
     }
     impl OrbitRateSource for Fixed {
         fn read_orbit_rate_radps(&mut self, _: u32) -> Result<f32, ErrorKind> {
             Ok(1.06e-3)
+        }
+        fn read_true_anomaly_rad(&mut self, _: u32) -> Result<f32, ErrorKind> {
+            Ok(0.0)
         }
     }
     struct Reel {
@@ -220,9 +263,17 @@ mod tests {
         }
     }
 
+    fn flight() -> Controller<f32> {
+        let cfg = Config {
+            rate_source: crate::config::RateSource::Estimator(estimator::Config::paper()),
+            ..Config::paper()
+        };
+        Controller::new(cfg).unwrap()
+    }
+
     #[test]
     fn a_failed_read_is_a_dropout_and_the_reel_still_gets_a_command() {
-        let mut ctl = Controller::new(Config::<f32>::paper()).unwrap();
+        let mut ctl = flight();
         let mut length = Fixed {
             length_m: 100.0,
             fail_at: Some(1),
@@ -235,12 +286,17 @@ mod tests {
             length_m: 0.0,
             fail_at: None,
         };
+        let mut others3 = Fixed {
+            length_m: 0.0,
+            fail_at: None,
+        };
         let mut reel = Reel { last: None };
         let mut dev = Devices {
             length: &mut length,
             swing: &mut others,
             orbit: &mut others2,
             reel: &mut reel,
+            tension: &mut others3,
         };
         let c0 = control_cycle(&mut ctl, 0, &mut dev);
         assert!(c0.sensor_error.is_none() && ctl.output().fault.is_none());
@@ -250,5 +306,36 @@ mod tests {
         assert_eq!((o.tick, o.fault), (1, Some(Fault::Sensor(Sensor::Missing))));
         assert_eq!(o.health, Health::Degraded);
         assert_eq!(reel.last, Some(o.rate_cmd_mps));
+    }
+
+    #[test]
+    fn without_alpha_the_estimate_is_predicted_and_the_law_still_runs() {
+        let mut ctl = flight();
+        let fixed = |fail_at| Fixed {
+            length_m: 100.0,
+            fail_at,
+        };
+        let (mut length, mut swing, mut orbit, mut load) =
+            (fixed(None), fixed(Some(2)), fixed(None), fixed(None));
+        let mut reel = Reel { last: None };
+        let mut dev = Devices {
+            length: &mut length,
+            swing: &mut swing,
+            orbit: &mut orbit,
+            reel: &mut reel,
+            tension: &mut load,
+        };
+        for tick in 0..2 {
+            let c = control_cycle(&mut ctl, tick, &mut dev);
+            // The encoder gives no rate: a reading error, not a dropout.
+            assert_eq!(c.sensor_error, None);
+            assert_eq!(c.reading_error, Some(ErrorKind::NoSample));
+        }
+        let c = control_cycle(&mut ctl, 2, &mut dev);
+        assert_eq!(c.reading_error, Some(ErrorKind::Device));
+        let o = ctl.output();
+        assert_eq!((o.fault, o.health), (None, Health::Nominal), "{o:?}");
+        assert_eq!(o.nis, None);
+        assert!(ctl.estimate().is_some());
     }
 }

@@ -6,7 +6,7 @@
 //! every malformed frame with a typed [`LinkError`] (the property test `tests/link.rs` feeds it
 //! arbitrary and mutated bytes).
 //!
-//! # Frame layout (version [`VERSION`] = 1)
+//! # Frame layout (version [`VERSION`] = 2)
 //!
 //! On the wire a frame is its COBS encoding (Cheshire & Baker 1999: no `0x00` inside) followed
 //! by one `0x00` delimiter, so a receiver can resynchronise on the next `0x00` after any error.
@@ -29,14 +29,15 @@
 //! ```text
 //! Hello   (firmware → plant, once at start, n = 9)
 //!         config_digest u32, period_ms u32, timeout_periods u8
-//! Sample  (plant → firmware, once per period, n = 21)
-//!         tick u32, status u8 (0 valid, 1 no sample), length_m f32, alpha_rad f32,
-//!         alpha_rate_radps f32, orbit_rate_radps f32
-//! Command (firmware → plant, once per period, n = 52)
+//! Sample  (plant → firmware, once per period, n = 21 to 37)
+//!         tick u32, status u8 (0 valid, 1 no sample), length_m f32, reel_rate_mps opt,
+//!         tension_n opt, alpha_rad opt, alpha_rate_radps opt, orbit_rate_radps f32,
+//!         true_anomaly_rad f32
+//! Command (firmware → plant, once per period, n = 53 or 57)
 //!         tick u32, sample u8 (SampleStatus: how this period's sample arrived),
 //!         rate_cmd_mps f32, accel_cmd_mps2 f32, law_rate_mps f32, blend_weight f32,
 //!         alpha_ref_rad f32, alpha_ref_rate_radps f32, delta_rad f32, delta_rate_radps f32,
-//!         length_estimate_m f32, equilibrium_margin f32,
+//!         length_estimate_m f32, equilibrium_margin f32, nis opt,
 //!         phase u8, health u8, fault u8 (see `fault_code`), flags u32
 //! End     (plant → firmware, once at the end, n = 4)
 //!         ticks u32 (control periods the plant ran); its seq follows the last sample's, so
@@ -45,6 +46,10 @@
 //!         the firmware's LinkCounters, then commands u32 (sent), then digest u32 (FNV-1a over
 //!         the bit patterns of every rate command, as the replay mission's)
 //! ```
+//!
+//! `opt` is an optional f32 (postcard's `Option`): one byte 0 (absent), or 1 followed by the
+//! f32 (any other tag byte is [`LinkError::Malformed`]). Version 1 had no options: a sample
+//! carried α and α̇ always, and no reel rate, tension or true anomaly; a command no NIS.
 //!
 //! The largest frame (Report) is 6 + 60 + 4 = 70 bytes decoded, [`MAX_WIRE_LEN`] on the wire.
 //!
@@ -65,7 +70,7 @@ use crate::controller::{Fault, Flags, Health, Output, Phase, Sensor};
 use crate::law::LawFault;
 
 /// Protocol version carried in byte 0 of every frame (see the module docs).
-pub const VERSION: u8 = 1;
+pub const VERSION: u8 = 2;
 
 /// Decoded header length: version, seq, kind.
 pub const HEADER_LEN: usize = 6;
@@ -174,14 +179,20 @@ pub struct Sample {
     pub tick: u32,
     /// [`SAMPLE_VALID`] or [`SAMPLE_MISSING`] (then the readings are meaningless).
     pub status: u8,
-    /// Tether length l, m.
+    /// Tether length l from the reel encoder, m.
     pub length_m: f32,
+    /// The reel's rate from its encoder, m/s.
+    pub reel_rate_mps: Option<f32>,
+    /// Tension at the reel from the load cell, N.
+    pub tension_n: Option<f32>,
     /// In-plane angle α, rad.
-    pub alpha_rad: f32,
-    /// In-plane rate α̇, rad/s.
-    pub alpha_rate_radps: f32,
-    /// Orbit rate n, rad/s.
+    pub alpha_rad: Option<f32>,
+    /// In-plane rate α̇ from the optional rate sensor, rad/s.
+    pub alpha_rate_radps: Option<f32>,
+    /// Orbit rate θ̇, rad/s.
     pub orbit_rate_radps: f32,
+    /// True anomaly θ, rad.
+    pub true_anomaly_rad: f32,
 }
 
 /// `Command`: the controller's output for one period, with its telemetry, firmware → plant.
@@ -216,6 +227,8 @@ pub struct Command {
     pub length_estimate_m: f32,
     /// [`Output::equilibrium_margin`].
     pub equilibrium_margin: f32,
+    /// [`Output::nis`].
+    pub nis: Option<f32>,
     /// [`Output::phase`] ([`phase_code`]).
     pub phase: u8,
     /// [`Output::health`] ([`health_code`]).
@@ -615,7 +628,7 @@ pub fn health_from_code(c: u8) -> Option<Health> {
         .find(|&h| health_code(h) == c)
 }
 
-const SENSOR_FAULTS: [Sensor; 9] = [
+const SENSOR_FAULTS: [Sensor; 11] = [
     Sensor::Missing,
     Sensor::Tick,
     Sensor::Length,
@@ -625,6 +638,8 @@ const SENSOR_FAULTS: [Sensor; 9] = [
     Sensor::AlphaStuck,
     Sensor::AlphaRate,
     Sensor::OrbitRate,
+    Sensor::AlphaGated,
+    Sensor::AlphaLost,
 ];
 
 const LAW_FAULTS: [LawFault; 4] = [
@@ -650,6 +665,8 @@ pub fn fault_code(f: Option<Fault>) -> u8 {
                 Sensor::AlphaStuck => 6,
                 Sensor::AlphaRate => 7,
                 Sensor::OrbitRate => 8,
+                Sensor::AlphaGated => 9,
+                Sensor::AlphaLost => 10,
             }
         }
         Some(Fault::Law(l)) => {
@@ -693,6 +710,7 @@ impl Command {
             delta_rate_radps: o.delta_rate_radps,
             length_estimate_m: o.length_estimate_m,
             equilibrium_margin: o.equilibrium_margin,
+            nis: o.nis,
             phase: phase_code(o.phase),
             health: health_code(o.health),
             fault: fault_code(o.fault),
@@ -718,6 +736,7 @@ impl Command {
             delta_rate_radps: self.delta_rate_radps,
             length_estimate_m: self.length_estimate_m,
             equilibrium_margin: self.equilibrium_margin,
+            nis: self.nis,
             flags: Flags(self.flags),
             fault: fault_from_code(self.fault)?,
         })
@@ -947,6 +966,7 @@ mod tests {
             delta_rate_radps: -0.0,
             length_estimate_m: 30_000.0,
             equilibrium_margin: -1e6,
+            nis: Some(2.5),
             phase: 3,
             health: 2,
             fault: 0x21,
@@ -960,11 +980,22 @@ mod tests {
             tick: 42,
             status: SAMPLE_VALID,
             length_m: 1.0,
-            alpha_rad: -0.61,
-            alpha_rate_radps: 0.0,
+            reel_rate_mps: Some(0.1),
+            tension_n: Some(3e-5),
+            alpha_rad: Some(-0.61),
+            alpha_rate_radps: Some(0.0),
             orbit_rate_radps: 1.06e-3,
+            true_anomaly_rad: 3.1,
         };
         roundtrip(Message::Sample(sample));
+        let flight = Sample {
+            reel_rate_mps: None,
+            tension_n: None,
+            alpha_rad: None,
+            alpha_rate_radps: None,
+            ..sample
+        };
+        roundtrip(Message::Sample(flight));
         roundtrip(Message::Command(command()));
         roundtrip(Message::Hello(Hello {
             config_digest: 0xdead_beef,
@@ -993,8 +1024,14 @@ mod tests {
             let mut b = [0u8; MAX_FRAME_LEN];
             postcard::to_slice(&f, &mut b).unwrap().len() + CRC_LEN
         };
-        assert_eq!(raw_len(&Message::Sample(sample)), 6 + 21 + 4);
-        assert_eq!(raw_len(&Message::Command(command())), 6 + 52 + 4);
+        assert_eq!(raw_len(&Message::Sample(sample)), 6 + 37 + 4);
+        assert_eq!(raw_len(&Message::Sample(flight)), 6 + 21 + 4);
+        assert_eq!(raw_len(&Message::Command(command())), 6 + 57 + 4);
+        let no_nis = Command {
+            nis: None,
+            ..command()
+        };
+        assert_eq!(raw_len(&Message::Command(no_nis)), 6 + 53 + 4);
         assert_eq!(raw_len(&Message::End(End { ticks: 1 })), 6 + 4 + 4);
         assert_eq!(raw_len(&Message::Report(report)), 6 + 60 + 4);
         assert!(raw_len(&Message::Report(report)) <= MAX_FRAME_LEN);
@@ -1045,8 +1082,8 @@ mod tests {
         };
         let mut raw = vec![VERSION, 1, 0, 0, 0, 3, 1, 0, 0, 0];
         assert!(decode(&reframe(&raw)).is_ok());
-        raw[0] = 2;
-        assert_eq!(decode(&reframe(&raw)), Err(LinkError::Version(2)));
+        raw[0] = 1; // the version before the optional readings
+        assert_eq!(decode(&reframe(&raw)), Err(LinkError::Version(1)));
         raw[0] = VERSION;
         raw[5] = KINDS;
         assert_eq!(decode(&reframe(&raw)), Err(LinkError::UnknownKind(KINDS)));
@@ -1055,6 +1092,30 @@ mod tests {
         assert_eq!(decode(&reframe(&raw)), Err(LinkError::Malformed));
         raw.truncate(8);
         assert_eq!(decode(&reframe(&raw)), Err(LinkError::Truncated));
+
+        // An optional reading whose tag is neither 0 (absent) nor 1 (present).
+        let sample = Sample {
+            tick: 0,
+            status: SAMPLE_VALID,
+            length_m: 1.0,
+            reel_rate_mps: None,
+            tension_n: None,
+            alpha_rad: None,
+            alpha_rate_radps: None,
+            orbit_rate_radps: 1e-3,
+            true_anomaly_rad: 0.0,
+        };
+        let mut raw = [0u8; MAX_FRAME_LEN];
+        let frame = Frame {
+            version: VERSION,
+            seq: 0,
+            message: Message::Sample(sample),
+        };
+        let len = postcard::to_slice(&frame, &mut raw).unwrap().len();
+        // version, seq, kind, tick, status, length: the reel rate's tag is byte 6 + 9.
+        assert_eq!(raw[HEADER_LEN + 9], 0);
+        raw[HEADER_LEN + 9] = 2;
+        assert_eq!(decode(&reframe(&raw[..len])), Err(LinkError::Malformed));
 
         // An unknown enumeration code in a Command.
         let mut c = command();
@@ -1127,9 +1188,12 @@ mod tests {
             tick,
             status: SAMPLE_VALID,
             length_m: 1.0,
-            alpha_rad: 0.0,
-            alpha_rate_radps: 0.0,
+            reel_rate_mps: None,
+            tension_n: None,
+            alpha_rad: Some(0.0),
+            alpha_rate_radps: None,
             orbit_rate_radps: 1e-3,
+            true_anomaly_rad: 0.0,
         }
     }
 

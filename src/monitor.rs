@@ -51,10 +51,17 @@ pub enum Sensor {
     LengthJump,
     /// α missing (flying on a rate sensor), NaN, infinite or |α| > π.
     Alpha,
-    /// α jumped further than α̇ allows.
+    /// α jumped further than α̇ allows (flying on a rate sensor).
     AlphaJump,
-    /// α repeats exactly while α̇ says the tether is moving.
+    /// α repeats exactly while α̇ says the tether is moving (flying on a rate sensor).
     AlphaStuck,
+    /// α failed the estimator's χ² innovation gate (flying on the estimator: an outlier, or a
+    /// sensor that jumped or stuck; see [`crate::estimator`], *Gating and faults*).
+    AlphaGated,
+    /// No usable estimate of α and α̇ (flying on the estimator): no α sample yet, or none for
+    /// so long that the estimate's α uncertainty is beyond use (see
+    /// [`crate::controller`], *Flying on the estimator*).
+    AlphaLost,
     /// α̇ missing (flying on a rate sensor), NaN, infinite or beyond its plausible range.
     AlphaRate,
     /// Orbit rate NaN, infinite or outside [min, max].
@@ -67,6 +74,26 @@ pub const MIN_PLAUSIBLE_LENGTH_M: f64 = 1e-3;
 
 /// A sensed length beyond the spool end by more than this fraction is a sensor fault.
 pub const SPOOL_MARGIN: f64 = 0.05;
+
+/// What the law may use of an accepted sample's swing sensing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Swing<T> {
+    /// The sensed α and α̇ (rad, rad/s), flying on a rate sensor.
+    Sensed(T, T),
+    /// The sensed α (rad) for the estimator, if the swing sensor gave one.
+    Angle(Option<T>),
+}
+
+/// The angle checks, by rate source.
+#[derive(Clone, Copy, Debug)]
+enum AngleChecks<T> {
+    /// Flying on a rate sensor: α and α̇ required, and the α-jump and α-stuck checks judged
+    /// against the last accepted sample (`None` before the first).
+    RateSensor(Option<Accepted<T>>),
+    /// Flying on the estimator: α optional (a dropout of the swing sensor alone is not a bad
+    /// sample), α̇ ignored; the estimator's innovation gate replaces the jump and stuck checks.
+    Estimator,
+}
 
 /// The last accepted sample, for the consistency checks, and the run of identical α
 /// readings it ends (the stuck-sensor check).
@@ -88,8 +115,8 @@ pub(crate) struct Monitor<T> {
     min_length_m: T,
     /// The spool end plus [`SPOOL_MARGIN`], m.
     max_length_m: T,
-    /// The last accepted sample (`None` before the first).
-    last: Option<Accepted<T>>,
+    /// The angle checks of the rate source.
+    angles: AngleChecks<T>,
 }
 
 /// `lo ≤ v ≤ hi` (false for NaN).
@@ -104,9 +131,10 @@ fn magnitude_within<T: Real>(v: T, max: T) -> bool {
 
 impl<T: Real> Monitor<T> {
     /// A monitor for a validated configuration: `spool_m` is the longest plausible length (the
-    /// spool end plus [`SPOOL_MARGIN`]). Fails if that is not finite or below
-    /// [`MIN_PLAUSIBLE_LENGTH_M`] (no length could ever be accepted).
-    pub(crate) fn new(spool_m: T) -> Result<Self, ConfigError> {
+    /// spool end plus [`SPOOL_MARGIN`]); `rate_sensor` when the law flies on a sensed α̇.
+    /// Fails if the length is not finite or below [`MIN_PLAUSIBLE_LENGTH_M`] (no length could
+    /// ever be accepted).
+    pub(crate) fn new(spool_m: T, rate_sensor: bool) -> Result<Self, ConfigError> {
         let min_length_m = T::from_f64(MIN_PLAUSIBLE_LENGTH_M);
         if !spool_m.is_finite() {
             return Err(ConfigError::new(
@@ -125,36 +153,50 @@ impl<T: Real> Monitor<T> {
         Ok(Self {
             min_length_m,
             max_length_m: spool_m,
-            last: None,
+            angles: if rate_sensor {
+                AngleChecks::RateSensor(None)
+            } else {
+                AngleChecks::Estimator
+            },
         })
     }
 
-    /// Checks one sample of a controller flying on a rate sensor, and returns its α and α̇
-    /// (rad, rad/s). A sample without α or α̇ is rejected ([`Sensor::Alpha`],
-    /// [`Sensor::AlphaRate`]), as a missing sensor. `expected_length_m` is the length the
-    /// controller predicts for this tick (`None` when it has no trustworthy prediction). The
-    /// controller never checks a sample whose tick is before the last accepted one (it rejects
-    /// a tick that goes backwards first).
+    /// Checks one sample and returns what the law may use of its swing sensing. Flying on a
+    /// rate sensor, a sample without α or α̇ is rejected ([`Sensor::Alpha`],
+    /// [`Sensor::AlphaRate`]), as a missing sensor; flying on the estimator, α may be absent
+    /// and α̇ is not looked at. `expected_length_m` is the length the controller predicts for
+    /// this tick (`None` when it has no trustworthy prediction). The controller never checks a
+    /// sample whose tick is before the last accepted one (it rejects a tick that goes
+    /// backwards first).
     pub(crate) fn check(
         &mut self,
         cfg: &MonitorConfig<T>,
         x: &Input<T>,
         expected_length_m: Option<T>,
         period_s: T,
-    ) -> Result<(T, T), Sensor> {
+    ) -> Result<Swing<T>, Sensor> {
         // Range checks: each is false for NaN, and a finite bound excludes the infinities.
         if !within(x.length_m, self.min_length_m, self.max_length_m) {
             return Err(Sensor::Length);
         }
         let pi = T::from_f64(core::f64::consts::PI);
-        let Some(alpha_rad) = x.alpha_rad.filter(|&a| magnitude_within(a, pi)) else {
-            return Err(Sensor::Alpha);
-        };
-        let Some(alpha_rate_radps) = x
-            .alpha_rate_radps
-            .filter(|&r| magnitude_within(r, cfg.max_alpha_rate_radps))
-        else {
-            return Err(Sensor::AlphaRate);
+        let swing = match self.angles {
+            AngleChecks::RateSensor(_) => {
+                let Some(alpha_rad) = x.alpha_rad.filter(|&a| magnitude_within(a, pi)) else {
+                    return Err(Sensor::Alpha);
+                };
+                let Some(alpha_rate_radps) = x
+                    .alpha_rate_radps
+                    .filter(|&r| magnitude_within(r, cfg.max_alpha_rate_radps))
+                else {
+                    return Err(Sensor::AlphaRate);
+                };
+                Swing::Sensed(alpha_rad, alpha_rate_radps)
+            }
+            AngleChecks::Estimator => match x.alpha_rad {
+                Some(a) if !magnitude_within(a, pi) => return Err(Sensor::Alpha),
+                alpha => Swing::Angle(alpha),
+            },
         };
         if !within(
             x.orbit_rate_radps,
@@ -168,18 +210,36 @@ impl<T: Real> Monitor<T> {
                 return Err(Sensor::LengthJump);
             }
         }
-        let Some(last) = &mut self.last else {
-            self.last = Some(Accepted {
-                tick: x.tick,
+        if let (AngleChecks::RateSensor(last), Swing::Sensed(alpha_rad, alpha_rate_radps)) =
+            (&mut self.angles, swing)
+        {
+            Self::consistent(cfg, last, x.tick, alpha_rad, alpha_rate_radps, period_s)?;
+        }
+        Ok(swing)
+    }
+
+    /// The α-jump and α-stuck checks of a sensed α and α̇ at `tick`, against the last accepted
+    /// sample (which this one becomes when it passes).
+    fn consistent(
+        cfg: &MonitorConfig<T>,
+        last: &mut Option<Accepted<T>>,
+        tick: u32,
+        alpha_rad: T,
+        alpha_rate_radps: T,
+        period_s: T,
+    ) -> Result<(), Sensor> {
+        let Some(last) = last else {
+            *last = Some(Accepted {
+                tick,
                 alpha_rad,
                 alpha_rate_radps,
                 same_alpha_count: 1,
                 implied_motion_rad: T::ZERO,
             });
-            return Ok((alpha_rad, alpha_rate_radps));
+            return Ok(());
         };
         // At least one tick's allowance (a repeated tick predicts no motion).
-        let ticks = T::from_u32(x.tick.wrapping_sub(last.tick).max(1));
+        let ticks = T::from_u32(tick.wrapping_sub(last.tick).max(1));
         let predicted = last.alpha_rad + last.alpha_rate_radps * (ticks * period_s);
         if (alpha_rad - predicted).abs() > cfg.alpha_jump_rad * ticks {
             return Err(Sensor::AlphaJump);
@@ -198,10 +258,10 @@ impl<T: Real> Monitor<T> {
             last.implied_motion_rad = T::ZERO;
         }
         // Accepted: the run of identical readings goes on, or starts with this one.
-        last.tick = x.tick;
+        last.tick = tick;
         last.alpha_rad = alpha_rad;
         last.alpha_rate_radps = alpha_rate_radps;
-        Ok((alpha_rad, alpha_rate_radps))
+        Ok(())
     }
 }
 
@@ -225,7 +285,7 @@ mod tests {
     #[test]
     fn alpha_jump_is_judged_against_the_last_accepted_sample() {
         let cfg = MonitorConfig::<f64>::default_for_period();
-        let mut m = Monitor::new(42_000.0).unwrap();
+        let mut m = Monitor::new(42_000.0, true).unwrap();
         // No previous sample: any α in range is accepted.
         assert_eq!(
             m.check(&cfg, &sample(5, 3.0, 0.01), None, 1.0).map(drop),
@@ -263,13 +323,15 @@ mod tests {
             stuck_motion_rad: 0.015,
             ..MonitorConfig::default_for_period()
         };
-        let mut m = Monitor::new(42_000.0).unwrap();
+        let mut m = Monitor::new(42_000.0, true).unwrap();
         // 0.0 rad is not mistaken for a repeat of anything before the first reading.
         assert_eq!(
             m.check(&cfg, &sample(0, 0.0, 0.01), None, 1.0).map(drop),
             Ok(())
         );
-        let last = m.last.unwrap();
+        let AngleChecks::RateSensor(Some(last)) = m.angles else {
+            panic!("a rate-sensor monitor with an accepted sample");
+        };
         assert_eq!((last.same_alpha_count, last.implied_motion_rad), (1, 0.0));
         // Second identical reading: 2 in a row, 0.01 rad implied (< 0.015): still accepted.
         assert_eq!(
@@ -390,7 +452,7 @@ mod tests {
             ),
         ];
         for (x, expected) in cases {
-            let mut m = Monitor::new(42_000.0_f32).unwrap();
+            let mut m = Monitor::new(42_000.0_f32, true).unwrap();
             assert_eq!(m.check(&cfg, &x, None, 1.0), Err(expected), "{x:?}");
         }
         for x in [
@@ -408,8 +470,38 @@ mod tests {
                 ..ok
             },
         ] {
-            let mut m = Monitor::new(42_000.0_f32).unwrap();
+            let mut m = Monitor::new(42_000.0_f32, true).unwrap();
             assert_eq!(m.check(&cfg, &x, None, 1.0).map(drop), Ok(()), "{x:?}");
         }
+    }
+
+    #[test]
+    fn on_the_estimator_alpha_is_optional_its_rate_ignored_and_jumps_left_to_the_gate() {
+        let cfg = MonitorConfig::<f64>::default_for_period();
+        let mut m = Monitor::new(42_000.0, false).unwrap();
+        let x = |tick, alpha_rad: Option<f64>, rate: Option<f64>| Input {
+            alpha_rad,
+            alpha_rate_radps: rate,
+            ..sample(tick, 0.0, 0.0)
+        };
+        assert_eq!(
+            m.check(&cfg, &x(0, Some(0.5), None), None, 1.0),
+            Ok(Swing::Angle(Some(0.5)))
+        );
+        // No α: accepted, for the estimator to predict; α̇, even absurd, is not looked at.
+        assert_eq!(
+            m.check(&cfg, &x(1, None, Some(f64::NAN)), None, 1.0),
+            Ok(Swing::Angle(None))
+        );
+        // A jump far beyond alpha_jump_rad: the estimator's gate judges it, not the monitor.
+        assert_eq!(
+            m.check(&cfg, &x(2, Some(-2.0), Some(5.0)), None, 1.0),
+            Ok(Swing::Angle(Some(-2.0)))
+        );
+        // The range check stays.
+        assert_eq!(
+            m.check(&cfg, &x(3, Some(f64::INFINITY), None), None, 1.0),
+            Err(Sensor::Alpha)
+        );
     }
 }

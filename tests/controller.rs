@@ -727,3 +727,36 @@ fn on_the_rate_sensor_a_sample_without_alpha_or_its_rate_is_rejected() {
         assert_eq!(o.health, Health::Degraded);
     }
 }
+
+#[test]
+fn a_gap_in_the_calls_longer_than_the_estimator_carries_drops_the_estimate() {
+    use tss_reel::controller::{EventKind, MAX_CARRIED_PERIODS};
+    let mut ctl = Controller::new(Config::<f32>::flight()).unwrap();
+    let x = |tick| Input {
+        alpha_rate_radps: None,
+        ..sample(tick, 100.0)
+    };
+    let lost = |ctl: &mut Controller<f32>| {
+        let mut at = None;
+        while let Some(e) = ctl.pop_event() {
+            if e.kind == EventKind::EstimateLost {
+                at = Some(e.tick);
+            }
+        }
+        at
+    };
+    ctl.step(&x(0));
+    ctl.step(&x(1));
+    assert_eq!(lost(&mut ctl), None);
+    // Three periods later: the estimate is carried over each of them, and kept.
+    ctl.step(&x(4));
+    assert_eq!(lost(&mut ctl), None);
+    assert!(ctl.estimate().is_some());
+    // More periods than the estimator carries: dropped, and this sample starts it afresh.
+    let tick = 4 + MAX_CARRIED_PERIODS + 1;
+    let o = ctl.step(&x(tick));
+    assert_eq!(lost(&mut ctl), Some(tick));
+    let e = ctl.estimate().expect("restarted from this sample");
+    assert_eq!((e.alpha_rad, e.alpha_rate_radps), (-0.7, 0.0));
+    assert_eq!(o.nis, None);
+}

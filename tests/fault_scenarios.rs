@@ -479,13 +479,54 @@ fn lagging_reel_without_drive_limit_stays_taut_after_early_deployment() {
     );
 }
 
-/// HZ-5, open: σ_α̇ = 1e-6 rad/s. The law's rate command carries k1·l/((2+μ3)n)·σ_α̇ of noise
-/// (≈ 2.4 cm/s per µrad/s at 9 km), so the command jitters by the full acceleration limit and
-/// the tension (≈ 2.7 N at 9 km, 99 kg × 0.1 m/s² = 9.9 N swing) goes negative: 69 slack
-/// episodes, min −7.1 N at 32 535 s.
+/// Flies `file` with `overrides` on the controller configured to fly `RateSource::Estimator`
+/// (the EKF on α alone, `estimator::Config::paper()`: σ_α = 1e-4 rad): the sensed α̇ is not
+/// used.
+fn run_on_estimator(file: &str, overrides: &[&str]) -> History {
+    use tss_reel::controller::{Controller, RateSource};
+    use tss_reel::estimator;
+    let sc = scenario(file, overrides);
+    let mut cfg = sim::controller_config::<f32>(&sc).unwrap_or_else(|e| panic!("{e}"));
+    cfg.rate_source = RateSource::Estimator(estimator::Config::paper());
+    let mut ctl = Controller::new(cfg).unwrap_or_else(|e| panic!("{e}"));
+    let h = sim::run_stepper(&sc, &mut ctl, &PROBE_TIMES_S, &mut |_| {})
+        .unwrap_or_else(|e| panic!("{e}"));
+    eprintln!("{}", render_fault_summary(&sc, &h.faults));
+    h
+}
+
+/// HZ-5, O-5 closed: what flies has no α̇ sensor. The controller flies its estimator on α
+/// samples with 1e-4 rad of noise (and 1 cm of length noise) under the realistic reel limits:
+/// the tether stays taut after the early deployment (O-6's thin start is its own item), as on
+/// the true α̇.
 #[test]
-#[ignore = "open hazard (core): alpha-rate noise of 1e-6 rad/s slackens the tether during retrieval (69 episodes, min -7.1 N); the core does not filter the rate or limit by tension"]
 fn alpha_rate_noise_of_a_microradian_per_second_keeps_the_tether_taut() {
+    let h = run_on_estimator(
+        REEL_LIMITS,
+        &[
+            "sensors.seed=1",
+            "sensors.length.noise_std=0.01",
+            "sensors.alpha.noise_std=1e-4",
+        ],
+    );
+    let f = &h.faults;
+    assert!(
+        f.slack_episodes.iter().all(|e| e.1 <= 1_800.0),
+        "{:?}",
+        f.slack_episodes
+    );
+    assert_envelope(f, 0.0);
+    assert_eq!(f.final_health, Some(Health::Nominal));
+}
+
+/// Why the rate source matters (HZ-5): the paper's idealisation, a sensed α̇ flown as is, with
+/// white noise of only 1e-6 rad/s slackens the tether. The law's rate command carries
+/// k1·l/((2+μ3)n)·σ_α̇ of noise (≈ 2.4 cm/s per µrad/s at 9 km), so the command jitters by the
+/// full acceleration limit and the tension (≈ 2.7 N at 9 km, 99 kg × 0.1 m/s² = 9.9 N swing)
+/// goes negative: 69 slack episodes, min −7.1 N at 32 535 s. The estimator's α̇̂ errs by
+/// 3.6e-8 rad/s RMS, and smoothly (tests/estimator.rs).
+#[test]
+fn the_rate_sensor_path_with_alpha_rate_noise_of_a_microradian_per_second_slackens() {
     let h = run(
         REEL_LIMITS,
         &[
@@ -495,11 +536,17 @@ fn alpha_rate_noise_of_a_microradian_per_second_keeps_the_tether_taut() {
             "sensors.alpha_rate.noise_std=1e-6",
         ],
     );
-    assert!(
-        h.faults.slack_episodes.iter().all(|e| e.1 <= 1_800.0),
-        "{:?}",
-        h.faults.slack_episodes
+    let late: Vec<_> = h
+        .faults
+        .slack_episodes
+        .iter()
+        .filter(|e| e.1 > 1_800.0)
+        .collect();
+    eprintln!(
+        "rate sensor, σ_α̇ = 1e-6 rad/s: {} slack episodes after 1 800 s",
+        late.len()
     );
+    assert!(late.len() >= 10, "{late:?}");
 }
 
 /// HZ-8 (YES2: running past the target). The spool ends at 30 500 m, below the paper's 31.3 km

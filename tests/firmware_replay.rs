@@ -96,28 +96,35 @@ fn fnv1a(acc: u32, word: u32) -> u32 {
     h
 }
 
-/// The replay on the host: the same controller, the same inputs, the same dropout.
+/// The replay on the host: the same controller (the flight configuration: the paper's mission
+/// on the estimator), the same inputs (α only: the recording's α̇ is not a sensor that flies),
+/// the same dropout.
 fn host_commands() -> (Vec<f32>, u32) {
-    let mut ctl = Controller::new(Config::<f32>::paper()).unwrap();
+    let mut ctl = Controller::new(Config::<f32>::flight()).unwrap();
     let mut cmds = Vec::with_capacity(replay_data::SAMPLES.len());
     let mut digest = 0x811c_9dc5;
     for (tick, s) in replay_data::SAMPLES.iter().enumerate() {
         let tick = tick as u32;
-        let out =
-            if (replay_data::DROPOUT_FROM_TICK..replay_data::DROPOUT_UNTIL_TICK).contains(&tick) {
-                ctl.step_missing(tick)
-            } else {
-                ctl.step(&Input {
-                    tick,
-                    length_m: s[0],
-                    reel_rate_mps: None,
-                    tension_n: None,
-                    alpha_rad: Some(s[1]),
-                    alpha_rate_radps: Some(s[2]),
-                    orbit_rate_radps: replay_data::ORBIT_RATE_RADPS,
-                    true_anomaly_rad: 0.0,
-                })
-            };
+        let dropout = replay_data::DROPOUT_FROM_TICK..replay_data::DROPOUT_UNTIL_TICK;
+        let out = if dropout.contains(&tick) {
+            ctl.step_missing(tick)
+        } else {
+            // The encoder's rate: the recorded length's change over the period.
+            let before = tick
+                .checked_sub(1)
+                .filter(|t| !dropout.contains(t))
+                .map(|t| replay_data::SAMPLES[t as usize][0]);
+            ctl.step(&Input {
+                tick,
+                length_m: s[0],
+                reel_rate_mps: before.map(|b| (s[0] - b) / replay_data::PERIOD_S),
+                tension_n: None,
+                alpha_rad: Some(s[1]),
+                alpha_rate_radps: None,
+                orbit_rate_radps: replay_data::ORBIT_RATE_RADPS,
+                true_anomaly_rad: 0.0,
+            })
+        };
         digest = fnv1a(digest, out.rate_cmd_mps.to_bits());
         cmds.push(out.rate_cmd_mps);
     }

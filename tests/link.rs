@@ -31,22 +31,27 @@ fn any_f32() -> impl Strategy<Value = f32> {
     any::<u32>().prop_map(f32::from_bits)
 }
 
+/// An optional reading: absent, or any f32 bit pattern.
+fn any_opt_f32() -> impl Strategy<Value = Option<f32>> {
+    proptest::option::of(any_f32())
+}
+
 fn sample() -> impl Strategy<Value = Sample> {
     (
-        any::<u32>(),
-        0..=SAMPLE_MISSING,
-        any_f32(),
-        any_f32(),
-        any_f32(),
-        any_f32(),
+        (any::<u32>(), 0..=SAMPLE_MISSING, any_f32()),
+        (any_opt_f32(), any_opt_f32(), any_opt_f32(), any_opt_f32()),
+        (any_f32(), any_f32()),
     )
-        .prop_map(|(tick, status, l, a, ad, n)| Sample {
+        .prop_map(|((tick, status, l), (v, t, a, ad), (n, theta))| Sample {
             tick,
             status,
             length_m: l,
+            reel_rate_mps: v,
+            tension_n: t,
             alpha_rad: a,
             alpha_rate_radps: ad,
             orbit_rate_radps: n,
+            true_anomaly_rad: theta,
         })
 }
 
@@ -57,27 +62,30 @@ fn command() -> impl Strategy<Value = Command> {
         proptest::array::uniform10(any_f32()),
         0u8..5,
         0u8..3,
-        prop_oneof![Just(0u8), 0x10u8..0x19, 0x20u8..0x24],
-        any::<u32>(),
+        prop_oneof![Just(0u8), 0x10u8..0x1b, 0x20u8..0x24],
+        (any::<u32>(), any_opt_f32()),
     )
-        .prop_map(|(tick, sample, f, phase, health, fault, flags)| Command {
-            tick,
-            sample,
-            rate_cmd_mps: f[0],
-            accel_cmd_mps2: f[1],
-            law_rate_mps: f[2],
-            blend_weight: f[3],
-            alpha_ref_rad: f[4],
-            alpha_ref_rate_radps: f[5],
-            delta_rad: f[6],
-            delta_rate_radps: f[7],
-            length_estimate_m: f[8],
-            equilibrium_margin: f[9],
-            phase,
-            health,
-            fault,
-            flags,
-        })
+        .prop_map(
+            |(tick, sample, f, phase, health, fault, (flags, nis))| Command {
+                tick,
+                sample,
+                rate_cmd_mps: f[0],
+                accel_cmd_mps2: f[1],
+                law_rate_mps: f[2],
+                blend_weight: f[3],
+                alpha_ref_rad: f[4],
+                alpha_ref_rate_radps: f[5],
+                delta_rad: f[6],
+                delta_rate_radps: f[7],
+                length_estimate_m: f[8],
+                equilibrium_margin: f[9],
+                nis,
+                phase,
+                health,
+                fault,
+                flags,
+            },
+        )
 }
 
 fn message() -> impl Strategy<Value = Message> {
@@ -259,9 +267,12 @@ proptest! {
             tick,
             status: SAMPLE_VALID,
             length_m: 1.0,
-            alpha_rad: 0.0,
-            alpha_rate_radps: 0.0,
+            reel_rate_mps: None,
+            tension_n: None,
+            alpha_rad: Some(0.0),
+            alpha_rate_radps: None,
             orbit_rate_radps: 1e-3,
+            true_anomaly_rad: 0.0,
         };
         let mut gate = SampleGate::new();
         let mut c = LinkCounters::default();

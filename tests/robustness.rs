@@ -7,7 +7,11 @@
 //! the envelope.
 
 use proptest::prelude::*;
-use tss_reel::controller::{Config, Controller, Envelope, Fault, Flags, Input, Output, Sensor};
+use tss_reel::controller::{
+    Config, Controller, Envelope, Fault, Flags, Input, Output, RateSource, Sensor,
+};
+use tss_reel::estimator;
+use tss_reel::orbit::Orbit;
 
 /// A realistic reel: 10 m/s, 0.1 m/s², 0.5 m to 40 km (tighter than the paper's defaults, so
 /// the limits are exercised).
@@ -20,6 +24,16 @@ fn config() -> Config<f32> {
             max_length_m: 40_000.0,
         },
         ..Config::paper()
+    }
+}
+
+/// [`config`] flying the estimator (the flight's rate source) on an eccentric orbit (e = 0.1),
+/// so that the sample's true anomaly, reel rate and every optional field reach the filter.
+fn flight_config() -> Config<f32> {
+    Config {
+        rate_source: RateSource::Estimator(estimator::Config::paper()),
+        orbit: Orbit::elliptic(7_078_000.0, 0.1),
+        ..config()
     }
 }
 
@@ -41,6 +55,8 @@ enum Event {
         alpha_rad: f32,
         alpha_rate_radps: f32,
         orbit_rate_radps: f32,
+        /// The optional fields and the true anomaly, for the estimator (None: absent).
+        extra: Extra,
     },
     Missing {
         gap: u32,
@@ -51,12 +67,39 @@ enum Event {
     },
 }
 
+/// α present or not, the reel's rate, the tension (each present or not, any bits or plausible)
+/// and the true anomaly.
+#[derive(Clone, Copy, Debug)]
+struct Extra {
+    alpha_present: bool,
+    reel_rate_mps: Option<f32>,
+    tension_n: Option<f32>,
+    true_anomaly_rad: f32,
+}
+
+fn extra() -> impl Strategy<Value = Extra> {
+    (
+        prop_oneof![3 => Just(true), 1 => Just(false)],
+        proptest::option::of(field(-10.0, 10.0)),
+        proptest::option::of(field(0.0, 100.0)),
+        field(-7.0, 7.0),
+    )
+        .prop_map(
+            |(alpha_present, reel_rate_mps, tension_n, true_anomaly_rad)| Extra {
+                alpha_present,
+                reel_rate_mps,
+                tension_n,
+                true_anomaly_rad,
+            },
+        )
+}
+
 fn event() -> impl Strategy<Value = Event> {
     let gap = prop_oneof![Just(1u32), 0u32..5, any::<u32>()];
     prop_oneof![
-        8 => (gap.clone(), field(0.0, 45_000.0), field(-3.2, 3.2), field(-0.07, 0.07), field(0.0, 0.012))
-            .prop_map(|(gap, length_m, alpha_rad, alpha_rate_radps, orbit_rate_radps)| Event::Sample {
-                gap, length_m, alpha_rad, alpha_rate_radps, orbit_rate_radps
+        8 => (gap.clone(), field(0.0, 45_000.0), field(-3.2, 3.2), field(-0.07, 0.07), field(0.0, 0.012), extra())
+            .prop_map(|(gap, length_m, alpha_rad, alpha_rate_radps, orbit_rate_radps, extra)| Event::Sample {
+                gap, length_m, alpha_rad, alpha_rate_radps, orbit_rate_radps, extra
             }),
         1 => gap.prop_map(|gap| Event::Missing { gap }),
         1 => (1u32..100).prop_map(|by| Event::Backwards { by }),
@@ -106,14 +149,19 @@ fn assert_output_sane(out: &Output<f32>, prev_rate: f32, env: &Envelope<f32>) {
     }
 }
 
-/// Flies `events` from tick `start` and checks every output.
+/// Flies `events` from tick `start` on both rate sources (the rate sensor, and the estimator
+/// on an eccentric orbit) and checks every output.
 fn fly(start: u32, events: Vec<Event>) {
-    let cfg = config();
+    fly_on(config(), start, &events);
+    fly_on(flight_config(), start, &events);
+}
+
+fn fly_on(cfg: Config<f32>, start: u32, events: &[Event]) {
     let env = cfg.envelope;
     let mut ctl = Controller::new(cfg).unwrap();
     let mut tick = start;
     let mut prev_rate = cfg.initial_rate_mps;
-    for ev in events {
+    for ev in events.iter().cloned() {
         let out = match ev {
             Event::Sample {
                 gap,
@@ -121,17 +169,18 @@ fn fly(start: u32, events: Vec<Event>) {
                 alpha_rad,
                 alpha_rate_radps,
                 orbit_rate_radps,
+                extra,
             } => {
                 tick = tick.wrapping_add(gap);
                 ctl.step(&Input {
                     tick,
                     length_m,
-                    reel_rate_mps: None,
-                    tension_n: None,
-                    alpha_rad: Some(alpha_rad),
+                    reel_rate_mps: extra.reel_rate_mps,
+                    tension_n: extra.tension_n,
+                    alpha_rad: extra.alpha_present.then_some(alpha_rad),
                     alpha_rate_radps: Some(alpha_rate_radps),
                     orbit_rate_radps,
-                    true_anomaly_rad: 0.0,
+                    true_anomaly_rad: extra.true_anomaly_rad,
                 })
             }
             Event::Missing { gap } => {
@@ -151,9 +200,9 @@ fn fly(start: u32, events: Vec<Event>) {
 fn patterned_event() -> impl Strategy<Value = Event> {
     let gap = prop_oneof![8 => Just(1u32), 2 => Just(0u32), 1 => 2u32..40];
     prop_oneof![
-        12 => (gap.clone(), 1_000.0f32..1_010.0, -0.8f32..-0.6, -1e-3f32..1e-3, 1.0e-3f32..1.1e-3)
-            .prop_map(|(gap, length_m, alpha_rad, alpha_rate_radps, orbit_rate_radps)| Event::Sample {
-                gap, length_m, alpha_rad, alpha_rate_radps, orbit_rate_radps
+        12 => (gap.clone(), 1_000.0f32..1_010.0, -0.8f32..-0.6, -1e-3f32..1e-3, 1.0e-3f32..1.1e-3, extra())
+            .prop_map(|(gap, length_m, alpha_rad, alpha_rate_radps, orbit_rate_radps, extra)| Event::Sample {
+                gap, length_m, alpha_rad, alpha_rate_radps, orbit_rate_radps, extra
             }),
         2 => gap.prop_map(|gap| Event::Missing { gap }),
         1 => (1u32..100).prop_map(|by| Event::Backwards { by }),

@@ -540,19 +540,23 @@ impl PilLink {
                 tick,
                 status: SAMPLE_VALID,
                 length_m: x.length_m,
-                // This wire format has no α or α̇ absent: NaN, which the firmware's monitor
-                // rejects as it rejects a missing one.
-                alpha_rad: x.alpha_rad.unwrap_or(f32::NAN),
-                alpha_rate_radps: x.alpha_rate_radps.unwrap_or(f32::NAN),
+                reel_rate_mps: x.reel_rate_mps,
+                tension_n: x.tension_n,
+                alpha_rad: x.alpha_rad,
+                alpha_rate_radps: x.alpha_rate_radps,
                 orbit_rate_radps: x.orbit_rate_radps,
+                true_anomaly_rad: x.true_anomaly_rad,
             },
             None => Sample {
                 tick,
                 status: SAMPLE_MISSING,
                 length_m: 0.0,
-                alpha_rad: 0.0,
-                alpha_rate_radps: 0.0,
+                reel_rate_mps: None,
+                tension_n: None,
+                alpha_rad: None,
+                alpha_rate_radps: None,
                 orbit_rate_radps: 0.0,
+                true_anomaly_rad: 0.0,
             },
         };
         let mut wire = [0u8; MAX_WIRE_LEN];

@@ -24,8 +24,8 @@
 //!   (the pending bit is seen at the handler's end) and logged at the outer rate.
 //! - **Outer**, [`OUTER_PERIOD_TICKS`] inner ticks (1 s, the law's period): the main loop, in
 //!   thread mode, wakes on every SysTick (WFI), and when a law period has gone by it runs one
-//!   [`control_cycle`] of the flight controller (`Controller<f32>`, the paper's configuration)
-//!   and hands its rate command (Eq. 29–30) to the speed loop in a critical section. Law
+//!   [`control_cycle`] of the flight controller (`Controller<f32>`, `Config::flight`: on the
+//!   estimator) and hands its rate command (Eq. 29–30) to the speed loop in a critical section. Law
 //!   periods that went by without a step are outer overruns: counted and logged.
 //!
 //! ## Where the outer law's sensors come from
@@ -260,7 +260,7 @@ mod board {
     /// The outer loop's state.
     struct Outer {
         controller: Controller<f32>,
-        devices: Devices<Replay, Replay, Replay, CommandLatch>,
+        devices: Devices<Replay, Replay, Replay, CommandLatch, Replay>,
     }
 
     impl Outer {
@@ -361,7 +361,7 @@ mod board {
             }));
         });
 
-        let controller = match Controller::new(Config::paper()) {
+        let controller = match Controller::new(Config::flight()) {
             Ok(c) => c,
             Err(e) => defmt::panic!("controller configuration rejected: {}", e),
         };
@@ -372,6 +372,7 @@ mod board {
                 swing: Replay,
                 orbit: Replay,
                 reel: CommandLatch { latest: None },
+                tension: Replay,
             },
         };
 

@@ -31,6 +31,13 @@ pub enum EventKind {
     BlendRestart,
     /// This phase stopped getting closer to its keep length ([`super::Flags::NO_PROGRESS`]).
     NoProgress(Phase),
+    /// The estimator gave up on its prediction after consecutive gated samples and restarted α
+    /// from this sample ([`crate::estimator::Measurement::Reinitialised`]).
+    EstimateRestarted,
+    /// The estimator dropped its estimate (a drive it could not carry it over, a prediction
+    /// that left the physical range, or a gap in the calls longer than
+    /// [`super::MAX_CARRIED_PERIODS`]): the next α starts afresh.
+    EstimateLost,
 }
 
 /// An event and the tick it happened at.

@@ -1,5 +1,5 @@
-//! The reel controller: one fixed-step [`Controller::step`] from sensed length, α, α̇ and orbit
-//! rate to a reel-rate command, through the reference schedules (Eqs. 34, 35), the implicit
+//! The reel controller: one fixed-step [`Controller::step`] from sensed length, α (and α̇, or
+//! the onboard estimate of it) and orbit rate to a reel-rate command, through the reference schedules (Eqs. 34, 35), the implicit
 //! range-rate law (Eq. 27 + 29, docs/equations.md §5), the commanded acceleration (Eq. 30) and the mission
 //! sequencer (docs/equations.md §7).
 //!
@@ -36,8 +36,28 @@
 //!
 //! Time is an integer tick count (one tick = one control period); the controller never
 //! accumulates time in floating point.
+//!
+//! # Flying on the estimator
+//!
+//! [`RateSource::Sensor`] (the paper's idealisation, [`Config::paper`], Table 1) flies the law
+//! on the sensed α and α̇. [`RateSource::Estimator`] ([`Config::flight`], the firmware's) flies
+//! it on α̂ and α̇̂ of the onboard EKF ([`crate::estimator`]) from α alone, stepped once per
+//! period inside the step (docs/equations.md §13): the estimate is carried over the period
+//! under the drive the last step commanded (or the encoder's measured rate), then updated with
+//! this period's α. For the fault logic:
+//!
+//! - a sample the χ² gate rejects is a bad sample ([`Sensor::AlphaGated`]); after
+//!   `max_rejections` in a row the next one restarts α ([`EventKind::EstimateRestarted`]);
+//! - a period without α (the swing sensor silent, the rest of the sample good) is predicted
+//!   only and is **not** a bad sample, until the estimate is useless: Var(α̂) above
+//!   [`MAX_ALPHA_VARIANCE_IN_SAMPLES`] times the α sample's variance R (its standard deviation
+//!   ten times the sensor's), or no estimate at all (before the first α, or after the filter
+//!   dropped it: [`EventKind::EstimateLost`]) — then [`Sensor::AlphaLost`];
+//! - α̇ in the sample is not looked at; the monitor's α-jump and α-stuck checks (judged on a
+//!   sensed α̇) give way to the gate.
 
 mod clock;
+mod estimation;
 mod events;
 mod health;
 mod output;
@@ -45,8 +65,9 @@ mod sequencer;
 
 use crate::envelope::PreparedEnvelope;
 use crate::equilibrium::ExistenceMonitor;
+use crate::estimator::Estimate;
 use crate::law::{self, LawInput};
-use crate::monitor::{Monitor, SPOOL_MARGIN};
+use crate::monitor::{Monitor, Swing, SPOOL_MARGIN};
 use crate::real::Real;
 
 pub use crate::config::{
@@ -58,10 +79,12 @@ pub use events::{Event, EventKind, EVENT_CAPACITY};
 pub use output::{Fault, Flags, Health, Output, Phase};
 
 use clock::{Clock, Elapsed};
+use estimation::{Commanded, Estimated, Estimation};
 use events::EventRing;
 use health::{DeadReckoning, HealthMachine};
 use sequencer::{Progress, Sequencer};
 
+pub use estimation::{MAX_ALPHA_VARIANCE_IN_SAMPLES, MAX_CARRIED_PERIODS};
 pub use sequencer::PROGRESS_TIME_CONSTANTS;
 
 /// Bound on the reported [`Output::equilibrium_margin`] (x grows as 1/l toward docking).
@@ -75,6 +98,8 @@ pub struct Controller<T: Real> {
     envelope: PreparedEnvelope<T>,
     existence: ExistenceMonitor<T>,
     monitor: Monitor<T>,
+    /// The estimator the law flies on (`None`: it flies on the sensed α̇).
+    estimation: Option<Estimation<T>>,
     sequencer: Sequencer<T>,
     health: HealthMachine,
     length: DeadReckoning<T>,
@@ -106,10 +131,15 @@ impl<T: Real> Controller<T> {
         })?;
         // The longest plausible length: the spool end plus the monitor's margin.
         let spool_m = T::from_f64(cfg.envelope.max_length_m.to_f64() * (1.0 + SPOOL_MARGIN));
+        let estimation = match &cfg.rate_source {
+            RateSource::Sensor => None,
+            RateSource::Estimator(est) => Some(Estimation::new(est, &cfg.orbit)?),
+        };
         Ok(Self {
             envelope: PreparedEnvelope::new(cfg.envelope),
             existence,
-            monitor: Monitor::new(spool_m)?,
+            monitor: Monitor::new(spool_m, estimation.is_none())?,
+            estimation,
             sequencer: Sequencer::new(&cfg),
             health: HealthMachine::new(),
             length: DeadReckoning::new(spool_m),
@@ -136,6 +166,7 @@ impl<T: Real> Controller<T> {
                 delta_rate_radps: T::ZERO,
                 length_estimate_m: T::ZERO,
                 equilibrium_margin: T::ZERO,
+                nis: None,
                 flags: Flags(0),
                 fault: None,
             },
@@ -146,6 +177,13 @@ impl<T: Real> Controller<T> {
     /// The configuration.
     pub fn config(&self) -> &Config<T> {
         &self.cfg
+    }
+
+    /// Flying on the estimator: the estimate after the last step (`None` before the first α,
+    /// after the estimate was lost, and on the rate sensor). By value: the filter keeps its
+    /// state in its own form, and a step need not copy it out for a caller who may not ask.
+    pub fn estimate(&self) -> Option<Estimate<T>> {
+        self.estimation.as_ref().and_then(Estimation::estimate)
     }
 
     /// The current phase.
@@ -231,19 +269,35 @@ impl<T: Real> Controller<T> {
 
         // Check the inputs. Before the first accepted sample, and in safe hold, there is no
         // trusted prediction: the next valid sample (re-)anchors it.
-        let Some(x) = sample else {
-            let missing = Fault::Sensor(Sensor::Missing);
-            return self.reject(tick, predicted_m, missing, None, flags);
-        };
         let expected = match self.health.health() {
             Health::SafeHold => None,
             Health::Nominal | Health::Degraded => predicted_m,
         };
-        let (alpha_rad, alpha_rate_radps) =
-            match self.monitor.check(&self.cfg.monitor, x, expected, dt) {
-                Ok(angles) => angles,
-                Err(s) => return self.reject(tick, predicted_m, Fault::Sensor(s), None, flags),
-            };
+        let checked = match sample {
+            None => Err(Sensor::Missing),
+            Some(x) => self
+                .monitor
+                .check(&self.cfg.monitor, x, expected, dt)
+                .map(|swing| (x, swing)),
+        };
+        // The law's α and α̇: sensed, or estimated over the periods that passed (the estimate
+        // is carried over the period whether or not the sample was accepted).
+        let (accepted, swing) = match &checked {
+            Ok((x, swing)) => (Some(*x), *swing),
+            Err(_) => (None, Swing::Angle(None)),
+        };
+        let angles = self.swing(tick, elapsed_ticks, accepted, swing);
+        let x = match checked {
+            Ok((x, _)) => x,
+            Err(s) => return self.reject(tick, predicted_m, Fault::Sensor(s), None, flags),
+        };
+        let (alpha_rad, alpha_rate_radps) = match angles {
+            Ok(angles) => angles,
+            Err(s) => {
+                let sensed = Some(x.length_m);
+                return self.reject(tick, sensed, Fault::Sensor(s), None, flags);
+            }
+        };
         self.length.sensed(x.length_m);
 
         let reference = self.sequencer.reference(tick, x.length_m);
@@ -283,6 +337,9 @@ impl<T: Real> Controller<T> {
                 }
             };
         self.health.usable(&mut flags);
+        if let Some(est) = &mut self.estimation {
+            est.lend_sin_cos_two_alpha(alpha_rad, law.sin_two_alpha, law.cos_two_alpha);
+        }
 
         // The envelope. The acceleration limit holds per command: a command differs from the
         // previous one by at most a·Δt, whatever the calls' pattern (a gap of n ticks does
@@ -340,9 +397,59 @@ impl<T: Real> Controller<T> {
             delta_rate_radps: law.delta_rate_radps,
             length_estimate_m: x.length_m,
             equilibrium_margin: margin,
+            nis: self.estimation.as_ref().and_then(Estimation::nis),
             flags,
             fault: None,
         };
+        self.commanded(x.length_m, accel, mu3);
+    }
+
+    /// The α and α̇ the law flies on: the sensed ones, or the estimate carried over the
+    /// `periods` that passed and updated with the α of `swing` (`x`: the accepted sample, if
+    /// any). An estimator event is recorded at `tick`.
+    // Inlined into its one caller: out of line it cost a call, its prologue and the spills of
+    // its arguments: 30 instructions a step (scripts/bench-target, mission: median 1008 → 978,
+    // worst 1045 → 1018).
+    #[inline(always)]
+    fn swing(
+        &mut self,
+        tick: u32,
+        periods: u32,
+        x: Option<&Input<T>>,
+        swing: Swing<T>,
+    ) -> Result<(T, T), Sensor> {
+        match (&mut self.estimation, swing) {
+            (None, Swing::Sensed(alpha_rad, alpha_rate_radps)) => Ok((alpha_rad, alpha_rate_radps)),
+            (Some(est), Swing::Angle(alpha_rad)) => {
+                let sample = x.map(|x| (x.orbit_rate_radps, x.true_anomaly_rad, x.reel_rate_mps));
+                let (verdict, event) = est.step(periods, sample, alpha_rad);
+                if let Some(kind) = event {
+                    self.events.push(Event { tick, kind });
+                }
+                match verdict {
+                    Estimated::Usable(alpha_rad, alpha_rate_radps) => {
+                        Ok((alpha_rad, alpha_rate_radps))
+                    }
+                    Estimated::Unusable(s) => Err(s),
+                }
+            }
+            // Not reached: the monitor checks the angles by the same rate source.
+            (None, Swing::Angle(_)) => Err(Sensor::AlphaRate),
+            (Some(_), Swing::Sensed(..)) => Err(Sensor::AlphaLost),
+        }
+    }
+
+    /// Flying on the estimator: the command of this step, the drive of the next prediction
+    /// (the reel at `length_m`, at the kept command, accelerating at `accel_mps2`).
+    fn commanded(&mut self, length_m: T, accel_mps2: T, mu3: T) {
+        if let Some(est) = &mut self.estimation {
+            est.commanded(Commanded {
+                length_m,
+                rate_mps: self.last_rate_cmd_mps,
+                accel_mps2,
+                mu3,
+            });
+        }
     }
 
     /// No usable sample or no law solution at this tick: the health machine counts it, and
@@ -412,6 +519,7 @@ impl<T: Real> Controller<T> {
         self.last_rate_cmd_mps = rate;
         let mu3 = self.cfg.masses.mu3_and_slope(length_m).0;
         let x_rate = self.existence.normalised_rate(mu3, length_m, rate);
+        let accel_mps2 = (rate - previous) / dt;
         let margin = self.equilibrium_margin(x_rate);
         flags.set_if(margin < T::ZERO, Flags::NO_EQUILIBRIUM);
         self.out = Output {
@@ -419,7 +527,7 @@ impl<T: Real> Controller<T> {
             phase: self.sequencer.phase(),
             health: self.health.health(),
             rate_cmd_mps: rate,
-            accel_cmd_mps2: (rate - previous) / dt,
+            accel_cmd_mps2: accel_mps2,
             law_rate_mps: T::ZERO,
             blend_weight: self.sequencer.blend(now).weight,
             alpha_ref_rad,
@@ -428,9 +536,11 @@ impl<T: Real> Controller<T> {
             delta_rate_radps: T::ZERO,
             length_estimate_m: length_m,
             equilibrium_margin: margin,
+            nis: self.estimation.as_ref().and_then(Estimation::nis),
             flags,
             fault,
         };
+        self.commanded(length_m, accel_mps2, mu3);
     }
 
     /// The Eq. 13 whole-orbit margin of a command whose normalised rate (Eq. 7) is `x`:

@@ -126,10 +126,17 @@ pub struct Output<T> {
     pub alpha_ref_rad: T,
     /// α̇_r = (∂α_r/∂l) l̇_real + ∂α_r/∂t, rad/s.
     pub alpha_ref_rate_radps: T,
-    /// δ = α − α_r, rad (0 when the law did not run).
+    /// δ = α − α_r, rad (0 when the law did not run). α is the sensed angle or, flying on the
+    /// estimator, α̂ = α_r + δ.
     pub delta_rad: T,
-    /// δ̇ = α̇ − α̇_r, rad/s (0 when the law did not run).
+    /// δ̇ = α̇ − α̇_r, rad/s (0 when the law did not run). α̇ is the sensed rate or, flying on
+    /// the estimator, α̇̂ = α̇_r + δ̇.
     pub delta_rate_radps: T,
+    /// Flying on the estimator: the normalised innovation squared ν²/S of this period's α
+    /// sample (χ² with one degree of freedom for a consistent filter; above the gate, the
+    /// sample was rejected: [`super::Sensor::AlphaGated`]). `None` without a sample that met
+    /// an estimate, and on the rate sensor.
+    pub nis: Option<T>,
     /// The length the controller works with: the sensed one, or the prediction from the
     /// integrated command while coasting, m.
     pub length_estimate_m: T,

@@ -7,8 +7,9 @@
 //! recovers). The replay ([`tss_reel::recordings::sensors::Replay`], shared with the
 //! NUCLEO-G474RE firmware) implements the [`tss_reel::hal`] sensor traits; the reel drive is a
 //! telemetry sink that folds every command into a digest. The controller is the flight one:
-//! `tss_reel::controller::Controller<f32>` with the paper's configuration, stepped once per
-//! SysTick through [`tss_reel::hal::control_cycle`].
+//! `tss_reel::controller::Controller<f32>` with the flight configuration
+//! (`Config::flight`: the paper's mission on the onboard estimator, from the recorded α alone
+//! and the encoder's rate), stepped once per SysTick through [`tss_reel::hal::control_cycle`].
 //!
 //! The contract with the main loop in `main.rs`:
 //! - [`CONTROL_PERIOD_MS`]: the control period; one SysTick interrupt per period;
@@ -80,7 +81,7 @@ impl ReelDrive for TelemetryReel {
 /// The mission's state between ticks.
 pub struct Mission {
     controller: Controller<f32>,
-    devices: Devices<Replay, Replay, Replay, TelemetryReel>,
+    devices: Devices<Replay, Replay, Replay, TelemetryReel, Replay>,
 }
 
 impl Mission {
@@ -89,9 +90,10 @@ impl Mission {
     // which a default value must not do.
     #[allow(clippy::new_without_default)]
     pub fn new() -> Self {
-        // The paper's configuration is valid by construction; a rejection would be a build
+        // The paper's mission flown on the estimator (α only: the recording's α̇ is not a
+        // flight sensor); valid by construction: a rejection would be a build
         // defect, reported on the first tick.
-        let controller = Controller::new(Config::paper());
+        let controller = Controller::new(Config::flight());
         if let Err(e) = &controller {
             defmt::error!("controller configuration rejected: {}", e);
         }
@@ -105,6 +107,7 @@ impl Mission {
                     digest: fnv1a_start(),
                     count: 0,
                 },
+                tension: Replay,
             },
         }
     }
@@ -144,12 +147,12 @@ impl Mission {
         let cycle = self.control(tick);
         // In detail (`DEFMT_LOG=debug`): what this cycle sensed and what it commanded.
         match Replay::sample(tick) {
-            Ok(&[length_m, alpha_rad, alpha_rate_radps]) => defmt::debug!(
-                "t={=u32} sensed: l={=f32} m alpha={=f32} rad alpha_rate={=f32} rad/s n={=f32} rad/s",
+            // (The recording's α̇ is not a sensor that flies: the controller estimates it.)
+            Ok(&[length_m, alpha_rad, _]) => defmt::debug!(
+                "t={=u32} sensed: l={=f32} m alpha={=f32} rad n={=f32} rad/s",
                 tick,
                 length_m,
                 alpha_rad,
-                alpha_rate_radps,
                 ORBIT_RATE_RADPS
             ),
             Err(e) => defmt::debug!("t={=u32} sensed: nothing ({})", tick, e),

@@ -3,9 +3,10 @@
 //!
 //! The firmware announces itself with a `Hello` frame (protocol version, the digest of the
 //! controller configuration it flies, its period and sample timeout), then, for every control
-//! period: waits for the plant's `Sample` frame, runs [`tss_reel::hal::control_cycle`] with the
-//! sample behind the HAL sensor traits, and sends the `Command` frame (the whole controller
-//! output, so the plant side writes the same history as a host-linked run). An `End` frame
+//! period: waits for the plant's `Sample` frame, steps the controller on it (the frame carries
+//! the controller's whole `Input`, the optional readings included: α̇ for a controller that
+//! flies on a rate sensor, the reel's rate, the tension), and sends the `Command` frame (the
+//! whole controller output, so the plant side writes the same history as a host-linked run). An `End` frame
 //! closes the run: the firmware answers with a `Report` (its link counters and the digest of
 //! its commands), logs them, and exits with success.
 //!
@@ -20,19 +21,16 @@
 //! time; every line names its tick.
 //!
 //! **Link faults.** A period whose sample frame is missing (timeout), corrupted (COBS, CRC,
-//! version, … — see [`tss_reel::link`]) or reports no sample upstream is a failed sensor read
-//! (`ErrorKind::NoSample` / `ErrorKind::Corrupted`): the controller steps without a sample
+//! version, … — see [`tss_reel::link`]) or reports no sample upstream is a lost sample
+//! (`ErrorKind::NoSample` / `ErrorKind::Corrupted`): the controller steps without one
 //! (`Controller::step_missing`), exactly as in a sensor dropout. Duplicated and late
 //! (out-of-order) sample frames are discarded without using up the period, so the firmware
 //! keeps waiting for the right one. Every fault is logged with its tick and counted
 //! ([`tss_reel::link::LinkCounters`]); the counters are logged and reported at the end.
 
 use embedded_io::Write as _;
-use tss_reel::controller::{Config, Controller, Output};
-use tss_reel::hal::{
-    control_cycle, Devices, ErrorKind, ErrorType, LengthSensor, OrbitRateSource, ReelDrive, Swing,
-    SwingSensor,
-};
+use tss_reel::controller::{Config, Controller, Input, Output};
+use tss_reel::hal::{ErrorKind, ErrorType, ReelDrive};
 use tss_reel::link::{
     self, Command, FrameReader, Gate, Hello, LinkCounters, LinkError, Message, Report, Sample,
     SampleGate, SampleStatus, MAX_WIRE_LEN, SAMPLE_VALID,
@@ -71,32 +69,17 @@ enum Received {
     End(u32),
 }
 
-/// This period's sample as the sensors see it: readings, or why there are none.
-#[derive(Clone, Copy)]
-struct LinkSample(Result<Sample, ErrorKind>);
-
-impl ErrorType for LinkSample {
-    type Error = ErrorKind;
-}
-
-impl LengthSensor for LinkSample {
-    fn read_length_m(&mut self, _tick: u32) -> Result<f32, ErrorKind> {
-        self.0.map(|s| s.length_m)
-    }
-}
-
-impl SwingSensor for LinkSample {
-    fn read_swing(&mut self, _tick: u32) -> Result<Swing, ErrorKind> {
-        self.0.map(|s| Swing {
-            alpha_rad: s.alpha_rad,
-            alpha_rate_radps: s.alpha_rate_radps,
-        })
-    }
-}
-
-impl OrbitRateSource for LinkSample {
-    fn read_orbit_rate_radps(&mut self, _tick: u32) -> Result<f32, ErrorKind> {
-        self.0.map(|s| s.orbit_rate_radps)
+/// The controller's input of a valid sample frame for `tick`, field by field.
+fn input(tick: u32, s: &Sample) -> Input<f32> {
+    Input {
+        tick,
+        length_m: s.length_m,
+        reel_rate_mps: s.reel_rate_mps,
+        tension_n: s.tension_n,
+        alpha_rad: s.alpha_rad,
+        alpha_rate_radps: s.alpha_rate_radps,
+        orbit_rate_radps: s.orbit_rate_radps,
+        true_anomaly_rad: s.true_anomaly_rad,
     }
 }
 
@@ -292,26 +275,23 @@ pub fn run(_clock: ControlClock) -> ! {
                 }
             }
         };
-        let sample = LinkSample(reading);
+        let output = match reading {
+            Ok(s) => controller.step(&input(tick, &s)),
+            Err(_) => {
+                dropouts = dropouts.saturating_add(1);
+                controller.step_missing(tick)
+            }
+        };
         let mut reel = CommandLink {
             link: &mut link,
             status,
             count,
             digest,
         };
-        let mut devices = Devices {
-            length: sample,
-            swing: sample,
-            orbit: sample,
-            reel: &mut reel,
-        };
-        let cycle = control_cycle(&mut controller, tick, &mut devices);
+        let sent = reel.command(&output);
         count = reel.count;
         digest = reel.digest;
-        if cycle.sensor_error.is_some() {
-            dropouts = dropouts.saturating_add(1);
-        }
-        if let Some(e) = cycle.reel_error {
+        if let Err(e) = sent {
             defmt::error!("t={=u32} the command frame could not be sent: {}", tick, e);
             exit::failure();
         }

@@ -10,11 +10,11 @@
 //! boundary layer, so it imports [`crate::hal`] and nothing above it; [`crate::hal`] itself does
 //! not depend on the `recordings` feature.
 
-use super::replay::{DROPOUT_FROM_TICK, DROPOUT_UNTIL_TICK, ORBIT_RATE_RADPS, SAMPLES};
-use crate::hal::{ErrorKind, ErrorType, LengthSensor, OrbitRateSource, Swing, SwingSensor};
+use super::replay::{DROPOUT_FROM_TICK, DROPOUT_UNTIL_TICK, ORBIT_RATE_RADPS, PERIOD_S, SAMPLES};
+use crate::hal::{ErrorKind, ErrorType, LengthSensor, OrbitRateSource, SwingSensor, TensionSensor};
 
 /// The first 720 s of the paper's mission ([`super::replay`]) as the reel MCU's length
-/// encoder, swing sensor and orbit-rate source, one sample per control period (tick), with the
+/// encoder (length and rate), swing sensor (α), load cell (none) and orbit source, one sample per control period (tick), with the
 /// injected dropout: no length or swing sample at ticks
 /// [`DROPOUT_FROM_TICK`]`..`[`DROPOUT_UNTIL_TICK`], nor past the end of the recording
 /// ([`ErrorKind::NoSample`], which [`crate::hal::control_cycle`] turns into a missing step).
@@ -44,20 +44,37 @@ impl LengthSensor for Replay {
     fn read_length_m(&mut self, tick: u32) -> Result<f32, ErrorKind> {
         Self::sample(tick).map(|s| s[0])
     }
-}
-
-impl SwingSensor for Replay {
-    fn read_swing(&mut self, tick: u32) -> Result<Swing, ErrorKind> {
-        Self::sample(tick).map(|s| Swing {
-            alpha_rad: s[1],
-            alpha_rate_radps: s[2],
-        })
+    /// The encoder's rate: the recorded length's change over the period that ended at `tick`
+    /// (none at the first tick, nor when either end is missing). The replay is open loop: the
+    /// recorded tether moved as the recording's reel did, not as this controller commands, so
+    /// the estimator must be driven by what the reel did.
+    fn read_rate_mps(&mut self, tick: u32) -> Result<f32, ErrorKind> {
+        let before = Self::sample(tick.checked_sub(1).ok_or(ErrorKind::NoSample)?)?;
+        Self::sample(tick).map(|now| (now[0] - before[0]) / PERIOD_S)
     }
 }
 
+/// α only: the recording's α̇ is not a sensor that flies.
+impl SwingSensor for Replay {
+    fn read_alpha_rad(&mut self, tick: u32) -> Result<f32, ErrorKind> {
+        Self::sample(tick).map(|s| s[1])
+    }
+}
+
+/// The recording has no load cell.
+impl TensionSensor for Replay {
+    fn read_tension_n(&mut self, _tick: u32) -> Result<f32, ErrorKind> {
+        Err(ErrorKind::NoSample)
+    }
+}
+
+/// The paper's circular orbit: θ̇ = n at every tick, θ = 0 (not used at e = 0).
 impl OrbitRateSource for Replay {
     fn read_orbit_rate_radps(&mut self, _tick: u32) -> Result<f32, ErrorKind> {
         Ok(ORBIT_RATE_RADPS)
+    }
+    fn read_true_anomaly_rad(&mut self, _tick: u32) -> Result<f32, ErrorKind> {
+        Ok(0.0)
     }
 }
 
@@ -74,15 +91,11 @@ mod tests {
         for tick in 0..SAMPLES.len() as u32 + 5 {
             let dropout = (DROPOUT_FROM_TICK..DROPOUT_UNTIL_TICK).contains(&tick);
             let length = r.read_length_m(tick);
-            let swing = r.read_swing(tick);
+            let swing = r.read_alpha_rad(tick);
             match SAMPLES.get(tick as usize) {
                 Some(s) if !dropout => {
                     assert_eq!(length, Ok(s[0]), "tick {tick}");
-                    let expected = Swing {
-                        alpha_rad: s[1],
-                        alpha_rate_radps: s[2],
-                    };
-                    assert_eq!(swing, Ok(expected), "tick {tick}");
+                    assert_eq!(swing, Ok(s[1]), "tick {tick}");
                 }
                 _ => {
                     assert_eq!(length, Err(ErrorKind::NoSample), "tick {tick}");
@@ -118,13 +131,14 @@ mod tests {
     /// against the QEMU firmware's log.
     #[test]
     fn flown_through_control_cycle_it_commands_what_the_recording_does() {
-        let mut via_devices = Controller::new(Config::<f32>::paper()).unwrap();
-        let mut direct = Controller::new(Config::<f32>::paper()).unwrap();
+        let mut via_devices = Controller::new(Config::<f32>::flight()).unwrap();
+        let mut direct = Controller::new(Config::<f32>::flight()).unwrap();
         let mut dev = Devices {
             length: Replay,
             swing: Replay,
             orbit: Replay,
             reel: LastCommand(None),
+            tension: Replay,
         };
         let mut dropouts = 0;
         for (tick, s) in SAMPLES.iter().enumerate() {
@@ -139,10 +153,10 @@ mod tests {
                 direct.step(&Input {
                     tick,
                     length_m: s[0],
-                    reel_rate_mps: None,
+                    reel_rate_mps: Replay.read_rate_mps(tick).ok(),
                     tension_n: None,
                     alpha_rad: Some(s[1]),
-                    alpha_rate_radps: Some(s[2]),
+                    alpha_rate_radps: None,
                     orbit_rate_radps: ORBIT_RATE_RADPS,
                     true_anomaly_rad: 0.0,
                 })

@@ -1,0 +1,300 @@
+//! The law's α and α̇ from the onboard estimator ([`crate::estimator`]), when the controller
+//! flies [`RateSource::Estimator`](crate::config::RateSource::Estimator): each step carries the
+//! estimate over the period that just ended under the drive the last step commanded (or the
+//! reel's measured rate), updates it with this period's α, and says whether the law may fly on
+//! it (see the controller's docs, *Flying on the estimator*).
+
+use crate::config::{estimator_error, ConfigError};
+use crate::estimator::{self, Drive, Estimate, Estimator, Measurement, Prediction};
+use crate::monitor::Sensor;
+use crate::orbit::Orbit;
+use crate::real::Real;
+
+use super::events::EventKind;
+
+/// The most periods one step carries the estimate over (a gap in the calls): beyond it the
+/// estimate is dropped and the next α starts afresh. 32 periods is longer than any overrun a
+/// control loop survives, and bounds the step's work.
+pub const MAX_CARRIED_PERIODS: u32 = 32;
+
+/// The estimate is useless to the law once Var(α̂) exceeds this many times R, the α sample's
+/// variance (its standard deviation ten times the sensor's), and stays so until an α sample is
+/// used again: the estimator exists to be better than the sensor. With the paper's tuning a
+/// swing sensor silent after a settled estimate gets there in the time measured by
+/// `tests/estimator.rs::a_silent_swing_sensor_is_flown_through_until_the_estimate_is_useless`.
+pub const MAX_ALPHA_VARIANCE_IN_SAMPLES: f64 = 100.0;
+
+/// The orbit's terms of the libration dynamics at one sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct OrbitTerms<T> {
+    /// θ̇, rad/s.
+    rate_radps: T,
+    /// θ̈, rad/s².
+    accel_radps2: T,
+    /// μ/R³, 1/s².
+    gravity_gradient_per_s2: T,
+}
+
+/// What one step commanded of the reel for the coming period: the drive of the next
+/// prediction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Commanded<T> {
+    /// The length at the start of the period (the length estimate), m.
+    pub(super) length_m: T,
+    /// The rate command, m/s.
+    pub(super) rate_mps: T,
+    /// The commanded acceleration, m/s².
+    pub(super) accel_mps2: T,
+    /// μ3 at that length.
+    pub(super) mu3: T,
+}
+
+/// What the estimator made of this step's sample, for the law and the fault logic.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Estimated<T> {
+    /// The law flies on α̂ (rad) and α̇̂ (rad/s).
+    Usable(T, T),
+    /// No estimate the law may use: a bad sample of this kind ([`Sensor::AlphaGated`],
+    /// [`Sensor::AlphaLost`]).
+    Unusable(Sensor),
+}
+
+/// The estimator in the loop.
+#[derive(Clone, Debug)]
+pub(super) struct Estimation<T: Real> {
+    filter: Estimator<T>,
+    /// The configured orbit when it is eccentric (θ̈ and μ/R³ from θ); `None` on a circular
+    /// one (0 and θ̇²).
+    eccentric: Option<Orbit<T>>,
+    /// Var(α̂) beyond which the law may not use the estimate, rad².
+    max_alpha_var_rad2: T,
+    /// The orbit's terms at the last accepted sample (a period without one is carried with
+    /// them).
+    orbit: Option<OrbitTerms<T>>,
+    /// What the last step commanded (`None` before the first step).
+    commanded: Option<Commanded<T>>,
+    /// The NIS of the last step's α sample, if one met the estimate.
+    nis: Option<T>,
+    /// The estimate was found useless, and no α has been used since: it stays useless (its α
+    /// variance may shrink again while uncertainty swings from α̇ into α, which does not make it
+    /// any better).
+    useless: bool,
+}
+
+impl<T: Real> Estimation<T> {
+    /// The estimator of `cfg` (validated with the controller's configuration) on `orbit`.
+    pub(super) fn new(cfg: &estimator::Config<T>, orbit: &Orbit<T>) -> Result<Self, ConfigError> {
+        let filter = Estimator::new(*cfg).map_err(estimator_error)?;
+        let max_alpha_var_rad2 =
+            T::from_f64(MAX_ALPHA_VARIANCE_IN_SAMPLES) * filter.measurement_var_rad2();
+        Ok(Self {
+            filter,
+            eccentric: (orbit.eccentricity > T::ZERO).then_some(*orbit),
+            max_alpha_var_rad2,
+            orbit: None,
+            commanded: None,
+            nis: None,
+            useless: false,
+        })
+    }
+
+    /// The estimate after the last step.
+    pub(super) fn estimate(&self) -> Option<Estimate<T>> {
+        self.filter.estimate()
+    }
+
+    /// The law computed sin 2α and cos 2α for `alpha_rad` (the estimate's α̂): the next
+    /// prediction reuses them.
+    pub(super) fn lend_sin_cos_two_alpha(&mut self, alpha_rad: T, sin: T, cos: T) {
+        self.filter.lend_sin_cos_two_alpha(alpha_rad, sin, cos);
+    }
+
+    /// The NIS of the last step's α sample, if one met the estimate.
+    pub(super) fn nis(&self) -> Option<T> {
+        self.nis
+    }
+
+    /// This step commanded `c` for the coming period.
+    pub(super) fn commanded(&mut self, c: Commanded<T>) {
+        self.commanded = Some(c);
+    }
+
+    /// One step: carries the estimate over the `periods` that passed since the last step
+    /// (0 at the first), the reel having run at its measured rate `reel_rate_mps` (if the
+    /// encoder gave one) or at the last command, then updates it with this period's α
+    /// (`None`: the swing sensor gave nothing, or the sample was rejected). `orbit_rate_radps`
+    /// and `true_anomaly_rad` are those of an accepted sample (`None`: the last ones hold).
+    /// Returns the verdict and the event it makes, if any.
+    pub(super) fn step(
+        &mut self,
+        periods: u32,
+        sample: Option<(T, T, Option<T>)>,
+        alpha_rad: Option<T>,
+    ) -> (Estimated<T>, Option<EventKind>) {
+        let mut reel_rate_mps = None;
+        if let Some((orbit_rate_radps, true_anomaly_rad, measured)) = sample {
+            self.orbit = Some(self.orbit_terms(orbit_rate_radps, true_anomaly_rad));
+            reel_rate_mps = measured;
+        }
+        let lost = if periods > MAX_CARRIED_PERIODS {
+            let had = self.filter.estimate().is_some();
+            self.filter.reset();
+            had
+        } else {
+            // The periods before the last (a gap in the calls), then the last one, with the
+            // encoder's rate (that of the period that just ended).
+            let gap_lost = periods > 1 && self.carry_gap(periods - 1);
+            let last_lost = periods > 0 && self.carry(periods - 1, reel_rate_mps);
+            gap_lost || last_lost
+        };
+        let m = self.filter.update_with(alpha_rad);
+        let estimate = self.filter.estimate();
+        let (nis, event) = match m {
+            Measurement::Accepted(i) | Measurement::Gated(i) => (Some(i.nis), None),
+            Measurement::Reinitialised(i) => (Some(i.nis), Some(EventKind::EstimateRestarted)),
+            Measurement::Missing | Measurement::Invalid | Measurement::Initialised => (None, None),
+        };
+        self.nis = nis;
+        let event = if lost {
+            Some(EventKind::EstimateLost)
+        } else {
+            event
+        };
+        if matches!(
+            m,
+            Measurement::Accepted(_) | Measurement::Initialised | Measurement::Reinitialised(_)
+        ) {
+            self.useless = false;
+        }
+        let verdict = match (m, &estimate) {
+            (Measurement::Gated(_), _) => Estimated::Unusable(Sensor::AlphaGated),
+            (_, Some(e)) if !self.useless && e.alpha_var_rad2 <= self.max_alpha_var_rad2 => {
+                Estimated::Usable(e.alpha_rad, e.alpha_rate_radps)
+            }
+            _ => {
+                self.useless = true;
+                Estimated::Unusable(Sensor::AlphaLost)
+            }
+        };
+        (verdict, event)
+    }
+
+    /// Carries the estimate over the `k`-th period since the last step (see [`Self::drive`]);
+    /// `true` if the filter dropped it.
+    fn carry(&mut self, k: u32, reel_rate_mps: Option<T>) -> bool {
+        match self.drive(k, reel_rate_mps) {
+            Some(drive) => matches!(
+                self.filter.predict_period(&drive),
+                Prediction::InvalidDrive(_) | Prediction::Diverged
+            ),
+            None => {
+                self.filter.reset();
+                false
+            }
+        }
+    }
+
+    /// Carries the estimate over the first `periods` periods since the last step (a gap in the
+    /// calls: at most [`MAX_CARRIED_PERIODS`] − 1), at the last command; `true` if the filter
+    /// dropped it.
+    // Out of line: the loop inlined into the step cost 148 instructions on every nominal step
+    // (one period, no gap), its iterator's state spilled around the whole prediction
+    // (tools/trace_profile.py, tick 301).
+    #[inline(never)]
+    fn carry_gap(&mut self, periods: u32) -> bool {
+        let mut lost = false;
+        for k in 0..periods {
+            lost |= self.carry(k, None);
+        }
+        lost
+    }
+
+    /// The orbit's terms at a sample: θ̈ and μ/R³ from θ on an eccentric orbit, 0 and θ̇² on a
+    /// circular one.
+    fn orbit_terms(&self, rate_radps: T, true_anomaly_rad: T) -> OrbitTerms<T> {
+        match &self.eccentric {
+            Some(o) => OrbitTerms {
+                rate_radps,
+                accel_radps2: o.true_anomaly_accel_radps2(true_anomaly_rad),
+                gravity_gradient_per_s2: o.gravity_gradient_per_s2(true_anomaly_rad),
+            },
+            None => OrbitTerms {
+                rate_radps,
+                accel_radps2: T::ZERO,
+                gravity_gradient_per_s2: rate_radps * rate_radps,
+            },
+        }
+    }
+
+    /// The drive of the `k`-th period since the last step: the last step's command, its length
+    /// advanced by k periods of it; the rate measured over the period when the encoder gave
+    /// one (taken as the period's mean: the drive's rate at mid-period, so its start rate is
+    /// the mean less half the period's commanded change). `None` without a command or orbit
+    /// terms yet (then there is no estimate to carry either).
+    fn drive(&self, k: u32, reel_rate_mps: Option<T>) -> Option<Drive<T>> {
+        let (c, o) = (self.commanded?, self.orbit?);
+        let h = self.filter.config().period_s;
+        let rate_mps = match reel_rate_mps {
+            Some(mean) => mean - T::from_f64(0.5) * c.accel_mps2 * h,
+            None => c.rate_mps,
+        };
+        Some(Drive {
+            length_m: c.length_m + c.rate_mps * T::from_u32(k) * h,
+            rate_mps,
+            accel_mps2: c.accel_mps2,
+            orbit_rate_radps: o.rate_radps,
+            orbit_accel_radps2: o.accel_radps2,
+            gravity_gradient_per_s2: o.gravity_gradient_per_s2,
+            mu3: c.mu3,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_drive_takes_the_orbit_terms_from_theta_on_an_eccentric_orbit_only() {
+        let cfg = estimator::Config::<f64>::paper();
+        let circular = Estimation::new(&cfg, &Orbit::circular(7_078_000.0)).unwrap();
+        let n = 1.06e-3;
+        let t = circular.orbit_terms(n, 2.0);
+        assert_eq!((t.accel_radps2, t.gravity_gradient_per_s2), (0.0, n * n));
+        let orbit = Orbit::elliptic(7_078_000.0, 0.1);
+        let eccentric = Estimation::new(&cfg, &orbit).unwrap();
+        let theta = 2.0;
+        let t = eccentric.orbit_terms(n, theta);
+        assert_eq!(t.rate_radps, n);
+        assert_eq!(t.accel_radps2, orbit.true_anomaly_accel_radps2(theta));
+        assert_eq!(
+            t.gravity_gradient_per_s2,
+            orbit.gravity_gradient_per_s2(theta)
+        );
+        assert!(t.accel_radps2 != 0.0);
+    }
+
+    #[test]
+    fn the_drive_is_the_last_command_or_the_measured_mean_rate() {
+        let cfg = estimator::Config::<f64>::paper();
+        let mut e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0)).unwrap();
+        assert_eq!(e.drive(0, None), None);
+        e.orbit = Some(e.orbit_terms(1.06e-3, 0.0));
+        e.commanded(Commanded {
+            length_m: 100.0,
+            rate_mps: 2.0,
+            accel_mps2: 0.1,
+            mu3: 0.01,
+        });
+        let d = e.drive(0, None).unwrap();
+        assert_eq!(
+            (d.length_m, d.rate_mps, d.accel_mps2, d.mu3),
+            (100.0, 2.0, 0.1, 0.01)
+        );
+        // The encoder's mean rate over the period is the drive's rate at mid-period.
+        let d = e.drive(0, Some(2.2)).unwrap();
+        assert_eq!(d.rate_mps + 0.5 * d.accel_mps2 * 1.0, 2.2);
+        // The k-th period of a gap starts k periods of the command further on.
+        assert_eq!(e.drive(3, None).unwrap().length_m, 106.0);
+    }
+}
