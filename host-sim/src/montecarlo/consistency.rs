@@ -15,11 +15,13 @@
 //! [`EVERY_S`] of mission time; the report gives the fraction of instants inside the band and
 //! the averages over time from [`SETTLED_S`] on (after the release transient and the prior).
 //!
-//! The filter watched is the flight filter, `tss_reel::estimator::Estimator` in f32, tuned by
-//! `Scenario::estimator_config`, run beside the controller ([`Watched`]) on what the
-//! controller reads: the swing sensor's α (its noise, bias, quantum, latency and dropouts) and
-//! the drive over each period (the length the controller estimates, the reel's rate the
-//! encoder measured, else the rate command held, and the orbit's rate).
+//! The filter watched ([`Watched`]) is the controller's own when it flies on the estimator
+//! (`Controller::estimate`, `Output::nis`: the filter in the loop, on what the controller
+//! reads). A controller flying the α̇ sensor has none; then the flight filter,
+//! `tss_reel::estimator::Estimator` in f32 tuned by `Scenario::estimator_config`, runs beside
+//! it on the same readings: the swing sensor's α (its noise, bias, quantum, latency and
+//! dropouts) and the drive over each period (the length the controller estimates, the
+//! encoder's rate, else the rate command held, and the orbit's rate, circular).
 
 use std::fmt::Write as _;
 use std::io::{self, Write};
@@ -27,7 +29,7 @@ use std::io::{self, Write};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use tss_reel::controller::{Input, Output};
+use tss_reel::controller::{Controller, Input, Output, RateSource};
 use tss_reel::estimator::{ConfigError, Drive, Estimate, Estimator, Measurement};
 use tss_reel::mass::MassModel;
 use tss_reel::Real;
@@ -102,30 +104,69 @@ struct Seen {
     nis: Option<f64>,
 }
 
-/// The controller in the loop with the flight filter run beside it on the same readings
-/// ([`Stepper`]); it keeps the filter's estimate and NIS at every [`EVERY_S`].
-pub struct Watched<'a, S> {
-    inner: &'a mut S,
+/// The flight filter run beside a controller that flies the α̇ sensor, on the same readings.
+struct Shadow {
     filter: Estimator<f32>,
     masses: MassModel<f32>,
-    every_ticks: u32,
     /// (length estimate at the start of the period, rate command held over it) of the last
     /// step.
     last: Option<(f32, f32)>,
+}
+
+impl Shadow {
+    /// The drive of the period that ended at this sample: the controller's length estimate at
+    /// its start, the encoder's rate over it (else the rate command held), the orbit's rate
+    /// (circular: θ̈ = 0, μ/R³ = θ̇²). The first sample starts the filter with the drive of its
+    /// own instant.
+    fn drive(&self, x: &Input<f32>) -> Drive<f32> {
+        let n = x.orbit_rate_radps;
+        let (length_m, rate_mps, mu3) = match self.last {
+            Some((l, cmd)) => (
+                l,
+                x.reel_rate_mps.unwrap_or(cmd),
+                self.masses.mu3_and_slope(l).0,
+            ),
+            None => (x.length_m, 0.0, 0.0),
+        };
+        Drive {
+            length_m,
+            rate_mps,
+            accel_mps2: 0.0,
+            orbit_rate_radps: n,
+            orbit_accel_radps2: 0.0,
+            gravity_gradient_per_s2: n * n,
+            mu3,
+        }
+    }
+}
+
+/// The controller in the loop ([`Stepper`]), its estimate and NIS kept at every [`EVERY_S`]:
+/// its own filter's when it flies on the estimator (`Controller::estimate`, `Output::nis`),
+/// else those of the flight filter run beside it on the same readings (tuned by
+/// `Scenario::estimator_config`).
+pub struct Watched<'a> {
+    ctl: &'a mut Controller<f32>,
+    shadow: Option<Shadow>,
+    every_ticks: u32,
     seen: Vec<Seen>,
 }
 
-impl<'a, S: Stepper<f32>> Watched<'a, S> {
-    /// Watches `inner` flying `sc` (its estimator's tuning and its masses).
-    pub fn new(sc: &Scenario, inner: &'a mut S) -> Result<Self, ConfigError> {
-        let filter = Estimator::new(sc.estimator_config::<f32>())?;
+impl<'a> Watched<'a> {
+    /// Watches `ctl` flying `sc`.
+    pub fn new(sc: &Scenario, ctl: &'a mut Controller<f32>) -> Result<Self, ConfigError> {
+        let shadow = match ctl.config().rate_source {
+            RateSource::Estimator(_) => None,
+            RateSource::Sensor => Some(Shadow {
+                filter: Estimator::new(sc.estimator_config::<f32>())?,
+                masses: ctl.config().masses,
+                last: None,
+            }),
+        };
         let every_ticks = (EVERY_S / sc.controller.period_s).round().max(1.0) as u32;
         Ok(Self {
-            inner,
-            filter,
-            masses: sc.controller_config::<f32>().masses,
+            ctl,
+            shadow,
             every_ticks,
-            last: None,
             seen: Vec::new(),
         })
     }
@@ -162,65 +203,42 @@ impl<'a, S: Stepper<f32>> Watched<'a, S> {
         }
         run
     }
-
-    /// The drive of the period that ended at this sample: the controller's length estimate at
-    /// its start, the encoder's rate over it (else the rate command held), the orbit's rate
-    /// (circular: θ̈ = 0, μ/R³ = θ̇²).
-    fn drive(&self, input: Option<&Input<f32>>) -> Option<Drive<f32>> {
-        let (length_m, rate_cmd_mps) = self.last?;
-        let x = input?;
-        let n = x.orbit_rate_radps;
-        Some(Drive {
-            length_m,
-            rate_mps: reel_rate(x).unwrap_or(rate_cmd_mps),
-            accel_mps2: 0.0,
-            orbit_rate_radps: n,
-            orbit_accel_radps2: 0.0,
-            gravity_gradient_per_s2: n * n,
-            mu3: self.masses.mu3_and_slope(length_m).0,
-        })
-    }
 }
 
-impl<S: Stepper<f32>> Stepper<f32> for Watched<'_, S> {
+impl Stepper<f32> for Watched<'_> {
     fn step(&mut self, tick: u32, input: Option<&Input<f32>>) -> Result<Output<f32>, SimError> {
-        // The first sample (no drive yet) starts the filter with the drive of its own instant.
-        let drive = self.drive(input).or_else(|| {
-            input.map(|x| Drive {
-                length_m: x.length_m,
-                rate_mps: 0.0,
-                accel_mps2: 0.0,
-                orbit_rate_radps: x.orbit_rate_radps,
-                orbit_accel_radps2: 0.0,
-                gravity_gradient_per_s2: x.orbit_rate_radps * x.orbit_rate_radps,
-                mu3: 0.0,
-            })
-        });
-        let step = drive.map(|d| self.filter.step(&d, input.and_then(alpha)));
-        let out = self.inner.step(tick, input)?;
-        self.last = Some((out.length_estimate_m, out.rate_cmd_mps));
+        // The shadow filter sees what the controller sees: a missing sample, or this one.
+        let shadow = match (&mut self.shadow, input) {
+            (Some(s), Some(x)) => {
+                let d = s.drive(x);
+                Some(s.filter.step(&d, x.alpha_rad))
+            }
+            _ => None,
+        };
+        let out = Stepper::step(&mut *self.ctl, tick, input)?;
+        if let Some(s) = &mut self.shadow {
+            s.last = Some((out.length_estimate_m, out.rate_cmd_mps));
+        }
         if tick.is_multiple_of(self.every_ticks) {
-            self.seen.push(Seen {
-                tick,
-                estimate: step.and_then(|s| s.estimate),
-                nis: step.and_then(|s| match s.measurement {
-                    Measurement::Accepted(i) | Measurement::Gated(i) => Some(f64::from(i.nis)),
-                    _ => None,
-                }),
-            });
+            let seen = match &self.shadow {
+                Some(_) => Seen {
+                    tick,
+                    estimate: shadow.and_then(|s| s.estimate),
+                    nis: shadow.and_then(|s| match s.measurement {
+                        Measurement::Accepted(i) | Measurement::Gated(i) => Some(f64::from(i.nis)),
+                        _ => None,
+                    }),
+                },
+                None => Seen {
+                    tick,
+                    estimate: self.ctl.estimate(),
+                    nis: out.nis.map(f64::from),
+                },
+            };
+            self.seen.push(seen);
         }
         Ok(out)
     }
-}
-
-/// The α the swing sensor delivered with this sample.
-fn alpha(x: &Input<f32>) -> Option<f32> {
-    x.alpha_rad
-}
-
-/// The reel's rate the encoder measured over the last period.
-fn reel_rate(x: &Input<f32>) -> Option<f32> {
-    x.reel_rate_mps
 }
 
 /// One run's NEES and NIS at each instant k·[`EVERY_S`] (`None`: no estimate, no sample, or
