@@ -2,9 +2,11 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+pub mod compare;
 pub mod elastic;
 pub mod faults;
 pub mod history;
+pub mod laws;
 pub mod montecarlo;
 pub mod output;
 pub mod pil;

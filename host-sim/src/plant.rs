@@ -227,6 +227,40 @@ impl RigidModel {
         }
     }
 
+    /// Eq. 5a solved for l̈ under a tension T = `tension_n` held by the reel, m/s²:
+    /// l̈ = −μ1 l̇²/l + μ2 l(…) − T/m_r, i.e. (T_t(l̈ = 0) − T)/m_r with T_t of
+    /// [`RigidModel::tension_n`] (the same expression, so tension and acceleration agree).
+    pub fn length_accel_mps2(&self, x: &State, rate_mps: f64, tension_n: f64) -> f64 {
+        let m_r = self.masses.coefficients(x[ix::LENGTH]).radial_kg;
+        (self.tension_n(x, rate_mps, 0.0) - tension_n) / m_r
+    }
+
+    /// One RK4 step of `h_s` seconds with the reel holding the tension `tension_n`: the state
+    /// and the reel's rate l̇ = `rate_mps` integrated together (l̇ is a state here, its
+    /// derivative Eq. 5a's l̈). Returns the new state and rate.
+    pub fn rk4_step_tension(
+        &self,
+        x: &State,
+        rate_mps: f64,
+        tension_n: f64,
+        h_s: f64,
+    ) -> (State, f64) {
+        let d = |y: &State, v: f64| {
+            (
+                self.derivative(y, v),
+                self.length_accel_mps2(y, v, tension_n),
+            )
+        };
+        let (k1, a1) = d(x, rate_mps);
+        let (k2, a2) = d(&(x + k1 * (0.5 * h_s)), rate_mps + a1 * (0.5 * h_s));
+        let (k3, a3) = d(&(x + k2 * (0.5 * h_s)), rate_mps + a2 * (0.5 * h_s));
+        let (k4, a4) = d(&(x + k3 * h_s), rate_mps + a3 * h_s);
+        (
+            x + (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h_s / 6.0),
+            rate_mps + (a1 + 2.0 * a2 + 2.0 * a3 + a4) * (h_s / 6.0),
+        )
+    }
+
     /// Tether tension from Eq. 5a with l̇ = `rate_mps` and l̈ = `accel_mps2`, N:
     /// T_t = m_r[−l̈ − μ1 l̇²/l + μ2 l(β̇² + (θ̇+α̇)² cos²β + (μ/R³)(3cos²α cos²β − 1))].
     /// A value ≤ 0 means a slack tether.
@@ -253,6 +287,11 @@ pub struct Command {
     /// The acceleration the controller commanded with it, m/s² (the rigid plant's tension of
     /// Eq. 5a under the ideal reel uses it).
     pub accel_mps2: f64,
+    /// A tension command instead, N (`Some`: a tension law, `crate::laws`; the rate and
+    /// acceleration are then ignored). The reel holds this tension, not a rate: on the rigid
+    /// plant l̈ follows from Eq. 5a ([`RigidModel::length_accel_mps2`]), on the elastic plant
+    /// the drum's motor applies the torque T·r. A tether only pulls: a negative value acts as 0.
+    pub tension_n: Option<f64>,
 }
 
 /// What the sensors would read without errors.
@@ -359,7 +398,10 @@ impl Plant for RigidPlant {
         let c = self.applied(command);
         // The tension of Eq. 5a at the start of the period: with the ideal reel l̈ is the
         // commanded acceleration; with a real drive, its actual rate and acceleration.
-        let (tension_n, reel) = if self.reel.is_ideal() {
+        let (tension_n, reel) = if let Some(t) = c.tension_n {
+            // A tension-commanded reel holds the commanded tension (≥ 0: a tether only pulls).
+            (t.max(0.0), ReelSaturation::default())
+        } else if self.reel.is_ideal() {
             let t = self.model.tension_n(x, c.rate_mps, c.accel_mps2);
             (t, ReelSaturation::default())
         } else {
@@ -392,7 +434,15 @@ impl Plant for RigidPlant {
     fn step(&mut self, command: &Command, period_s: f64) {
         let rate = self.applied(command).rate_mps;
         let h = period_s / f64::from(self.substeps);
-        if self.reel.is_ideal() {
+        if let Some(t) = self.applied(command).tension_n {
+            // Tension-commanded: the reel's rate is a state (kept in `reel.rate_mps`), driven
+            // by Eq. 5a under the held tension; the drive's lag and limits do not apply.
+            let mut v = self.reel.rate_mps;
+            for _ in 0..self.substeps {
+                (self.x, v) = self.model.rk4_step_tension(&self.x, v, t.max(0.0), h);
+            }
+            self.reel.rate_mps = v;
+        } else if self.reel.is_ideal() {
             for _ in 0..self.substeps {
                 self.x = self.model.rk4_step(&self.x, rate, h);
             }
@@ -405,7 +455,7 @@ impl Plant for RigidPlant {
     }
 
     fn is_finite(&self) -> bool {
-        self.x.iter().all(|v| v.is_finite())
+        self.x.iter().all(|v| v.is_finite()) && self.reel.rate_mps.is_finite()
     }
 }
 
@@ -545,6 +595,74 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Eq. 5a solved for l̈ inverts Eq. 5a's tension, and a reel holding the hanging tether's
+    /// tension keeps it hanging at rest (the tension-commanded mode of the tension laws).
+    #[test]
+    fn a_tension_commanded_reel_is_eq_5a_solved_for_the_acceleration() {
+        let rho = MassModel {
+            tether_density_kg_per_m: 1e-3,
+            ..MassModel::paper()
+        };
+        for masses in [MassModel::paper(), rho] {
+            let p = RigidModel {
+                orbit: Orbit::circular(7_078_000.0),
+                masses,
+            };
+            let x = State::from([0.3, 12_000.0, -0.4, 2e-4, 0.0, 0.0]);
+            for (v, a) in [(2.0, 0.01), (-3.0, -0.002), (0.0, 0.0)] {
+                let t = p.tension_n(&x, v, a);
+                let back = p.length_accel_mps2(&x, v, t);
+                assert!((back - a).abs() < 1e-12, "{v} {a}: {back}");
+            }
+            let hanging = State::from([0.0, 30_000.0, 0.0, 0.0, 0.0, 0.0]);
+            let t = p.tension_n(&hanging, 0.0, 0.0);
+            let (mut y, mut v) = (hanging, 0.0);
+            for _ in 0..1000 {
+                (y, v) = p.rk4_step_tension(&y, v, t, 1.0);
+            }
+            assert!((y[ix::LENGTH] - 30_000.0).abs() < 1e-6, "{}", y[ix::LENGTH]);
+            assert!(v.abs() < 1e-9 && y[ix::ALPHA].abs() < 1e-12);
+            // Less tension: the gravity gradient pays tether out.
+            let (mut y, mut v) = (hanging, 0.0);
+            for _ in 0..100 {
+                (y, v) = p.rk4_step_tension(&y, v, 0.9 * t, 1.0);
+            }
+            assert!(v > 0.0 && y[ix::LENGTH] > 30_000.0);
+        }
+    }
+
+    /// Energy under a tension-commanded reel: on a circular orbit with a massless tether, in the
+    /// orbit plane, Eqs. 5a–5b conserve H = ½m_r(l̇² + l²α̇²) − (3/2)m_r n² l² cos²α but for the
+    /// tension's power: dH/dt = −T l̇. With T held over each period the work is T·Δl exactly,
+    /// so H(t) − H(0) + Σ T_k Δl_k vanishes to the integrator's error, whatever T does.
+    #[test]
+    fn a_tension_commanded_reel_does_exactly_the_work_the_energy_loses() {
+        let p = paper_plant();
+        let n = p.orbit.mean_motion_radps();
+        let m_r = p.masses.coefficients(1.0).radial_kg;
+        let energy = |x: &State, v: f64| {
+            let (l, a, w) = (x[ix::LENGTH], x[ix::ALPHA], x[ix::ALPHA_RATE]);
+            0.5 * m_r * (v * v + l * l * w * w) - 1.5 * m_r * n * n * l * l * a.cos().powi(2)
+        };
+        let (mut x, mut v) = (State::from([0.0, 2_000.0, -0.3, 1e-4, 0.0, 0.0]), 1.5);
+        let h0 = energy(&x, v);
+        let mut work = 0.0;
+        let mut scale: f64 = h0.abs();
+        for k in 0..20_000 {
+            // A tension that pays out, brakes and winds in over the run.
+            let t = 3.0 * m_r * n * n * x[ix::LENGTH] * (1.0 + 0.5 * (f64::from(k) * 1e-3).sin());
+            let l0 = x[ix::LENGTH];
+            for _ in 0..4 {
+                (x, v) = p.rk4_step_tension(&x, v, t, 0.25);
+            }
+            work += t * (x[ix::LENGTH] - l0);
+            scale = scale.max(work.abs());
+        }
+        let residual = energy(&x, v) - h0 + work;
+        assert!(residual.abs() < 1e-9 * scale, "{residual} of {scale}");
+        assert!(work.abs() > 1.0, "the tension did work: {work}");
     }
 
     #[test]

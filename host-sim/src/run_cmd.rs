@@ -131,6 +131,14 @@ fn run_pil(args: &RunArgs) -> anyhow::Result<()> {
     // Checked here too, so that a scenario too long for the firmware is a usage error.
     let scenario = Scenario::load(&args.scenario, &args.set)?;
     pil::check_duration(&scenario).map_err(|e| UsageError(e.to_string()))?;
+    if scenario.controller.law != crate::scenario::LawName::Paper {
+        return Err(UsageError(format!(
+            "--pil flies the flight firmware, whose law is the paper's: controller.law = {:?} \
+             is a simulator law (run it without --pil)",
+            scenario.controller.law.as_str()
+        ))
+        .into());
+    }
     let mut report = None;
     let mut outcome = run_with(args, |sc, probes, out, progress| {
         let log = out.stage(FIRMWARE_LOG);

@@ -14,7 +14,7 @@ use crate::faults::{InjectionPlan, Injector, Reading, Sensed, SummaryBuilder, Ti
 use crate::history::{History, PhaseLabel, Sample};
 use crate::plant::{ix, Command, Observation, Plant, RigidModel, RigidPlant, State};
 use crate::reel::{Reel, ReelDrive};
-use crate::scenario::{PlantModel, Scenario};
+use crate::scenario::{LawName, PlantModel, Scenario};
 use tss_reel::controller::{Config, ConfigError, Controller, Input, Output, Phase};
 use tss_reel::orbit::Orbit;
 use tss_reel::schedule::BandSchedule;
@@ -109,7 +109,8 @@ pub fn initial_state<T: Real>(sc: &Scenario, cfg: &Config<T>) -> State {
     ])
 }
 
-/// Runs the scenario with the flight controller (f32) in the loop.
+/// Runs the scenario with its `[controller] law` in the loop: the flight controller (f32) for
+/// the paper's law, a tension law of `crate::laws` otherwise.
 ///
 /// `probe_times_s` are instants (whole control periods) at which the length is recorded in
 /// [`History::probes`]; `progress` is called with the mission time every simulated minute.
@@ -118,7 +119,10 @@ pub fn run(
     probe_times_s: &[f64],
     progress: &mut dyn FnMut(f64),
 ) -> Result<History, SimError> {
-    run_with::<f32>(sc, probe_times_s, progress)
+    match sc.controller.law {
+        LawName::Paper => run_with::<f32>(sc, probe_times_s, progress),
+        law => crate::laws::run(sc, law, probe_times_s, progress),
+    }
 }
 
 /// Runs the scenario with the controller evaluated in scalar type `T` (f32 is the flight
@@ -138,6 +142,19 @@ pub fn run_with<T: Real>(
 pub trait Stepper<T> {
     /// One control period: `input` is the sensed sample, `None` when none arrived (a dropout).
     fn step(&mut self, tick: u32, input: Option<&Input<T>>) -> Result<Output<T>, SimError>;
+
+    /// The reel command of the period `out` was decided for: the rate command and its
+    /// acceleration (the paper's law); a tension law (`crate::laws`) commands a tension.
+    fn reel_command(&self, out: &Output<T>) -> Command
+    where
+        T: Real,
+    {
+        Command {
+            rate_mps: out.rate_cmd_mps.to_f64(),
+            accel_mps2: out.accel_cmd_mps2.to_f64(),
+            tension_n: None,
+        }
+    }
 }
 
 impl<T: Real> Stepper<T> for Controller<T> {
@@ -191,6 +208,7 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
     let mut held = Command {
         rate_mps: sc.initial.length_rate_mps,
         accel_mps2: 0.0,
+        tension_n: None,
     };
     let mut last_length_m: Option<f64> = None;
     for tick in 0..=total {
@@ -216,10 +234,7 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
             Sensed::Sample(r) => stepper.step(tick, Some(&input(tick, &r)))?,
             Sensed::Missing => stepper.step(tick, None)?,
         };
-        let command = Command {
-            rate_mps: out.rate_cmd_mps.to_f64(),
-            accel_mps2: out.accel_cmd_mps2.to_f64(),
-        };
+        let command = stepper.reel_command(&out);
         let obs = plant.observe(&command);
         summary.record(
             &TickRecord {

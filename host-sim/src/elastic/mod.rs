@@ -369,13 +369,51 @@ impl State {
 enum ReelDrive {
     /// l̇ imposed (ideal, lag, locked).
     Rate(f64),
-    /// The drum's speed loop with this speed command, motion and brake.
+    /// The drum's motor with this speed command (or tension command: [`motor_torque`]),
+    /// motion and brake.
     Drum {
         drum: DrumParams,
         command_radps: f64,
+        tension_n: Option<f64>,
         motion: Motion,
         brake: bool,
     },
+}
+
+/// The drum motor's torque and its speed loop's integrator rate: the speed loop's
+/// ([`DrumParams::speed_loop`]) under a rate command; under a tension command T (a tension law,
+/// `crate::laws`) the motor holds the tether back with −T·r (T ≥ 0: a tether only pulls) and
+/// compensates its drum's friction from the drum's model: while the drum turns, the viscous and
+/// Coulomb friction fed forward from its speed (so J ω̇ = r(T_reel − T) while it turns); while
+/// it is stuck, the breakaway torque in the direction the tether's pull `reel_tension_n` − T
+/// would turn it (the tension at the reel is measured: the load cell of the controller's
+/// input). Clamped to the torque limit; the speed loop's integrator rests.
+fn motor_torque(
+    d: &DrumParams,
+    tension_n: Option<f64>,
+    reel_tension_n: f64,
+    command_radps: f64,
+    speed_radps: f64,
+    integral_rad: f64,
+) -> (f64, f64) {
+    match tension_n {
+        Some(t) => {
+            let t = t.max(0.0);
+            let friction = if speed_radps != 0.0 {
+                d.viscous_nms * speed_radps + d.coulomb_nm * speed_radps.signum()
+            } else {
+                let pull = reel_tension_n - t;
+                if pull != 0.0 {
+                    d.static_nm * pull.signum()
+                } else {
+                    0.0
+                }
+            };
+            let torque = -d.radius_m * t + friction;
+            (torque.clamp(-d.max_torque_nm, d.max_torque_nm), 0.0)
+        }
+        None => d.speed_loop(command_radps, speed_radps, integral_rad),
+    }
 }
 
 /// The angles of a direction in the centre of mass's orbit frame (docs/equations.md §0):
@@ -485,6 +523,9 @@ pub struct ElasticPlant {
     /// The control period the reel's saturation flags are judged over (the last one stepped;
     /// 1 s before the first), s.
     period_hint_s: f64,
+    /// The tension command of the current period (a tension law drives the drum's torque),
+    /// N; `None` under a rate command.
+    tension_cmd_n: Option<f64>,
     ws: Workspace,
 }
 
@@ -602,6 +643,7 @@ impl ElasticPlant {
             feeds: FeedCounts::default(),
             substeps_last: 0,
             period_hint_s: 1.0,
+            tension_cmd_n: None,
             ws: Workspace::default(),
         })
     }
@@ -867,6 +909,7 @@ impl ElasticPlant {
             ReelState::Motor { drum, motion } => ReelDrive::Drum {
                 drum,
                 command_radps: command / drum.radius_m,
+                tension_n: self.tension_cmd_n,
                 motion,
                 brake,
             },
@@ -899,7 +942,8 @@ impl ElasticPlant {
     /// One RK4 substep of `h` starting `t0` into the period, then the drum's stick/slip
     /// switch and the feeding rule.
     fn substep(&mut self, command: f64, t0: f64, h: f64) {
-        let brake = command == 0.0;
+        // The brake holds a zero rate command; a tension law commands the motor, never the brake.
+        let brake = command == 0.0 && self.tension_cmd_n.is_none();
         let motor = self.drum();
         if let Some(d) = motor {
             let drive = self.drum_drive_nm(&d, command);
@@ -989,11 +1033,6 @@ impl ElasticPlant {
 
     /// τ_m + r T_reel at the current state, N·m.
     fn drum_drive_nm(&self, d: &DrumParams, command: f64) -> f64 {
-        let (torque, _) = d.speed_loop(
-            command / d.radius_m,
-            self.y.drum_speed_radps,
-            self.y.drum_integral_rad,
-        );
         let y = &self.y;
         let dvec = y.pos[1] - y.pos[0];
         let chord = dvec.norm();
@@ -1007,6 +1046,14 @@ impl ElasticPlant {
             .p
             .tether
             .tension_n(chord, rate, l, d.radius_m * y.drum_speed_radps);
+        let (torque, _) = motor_torque(
+            d,
+            self.tension_cmd_n,
+            tension,
+            command / d.radius_m,
+            y.drum_speed_radps,
+            y.drum_integral_rad,
+        );
         torque + d.radius_m * tension
     }
 
@@ -1121,11 +1168,18 @@ fn derivative(
         ReelDrive::Drum {
             drum: d,
             command_radps,
+            tension_n,
             motion,
             brake,
         } => {
-            let (torque, integral_rate) =
-                d.speed_loop(command_radps, y.drum_speed_radps, y.drum_integral_rad);
+            let (torque, integral_rate) = motor_torque(
+                &d,
+                tension_n,
+                tension_reel,
+                command_radps,
+                y.drum_speed_radps,
+                y.drum_integral_rad,
+            );
             let drive = torque + d.radius_m * tension_reel;
             let accel = d.accel_radps2(motion, drive, y.drum_speed_radps, brake);
             (accel, integral_rate)
@@ -1203,6 +1257,20 @@ impl ElasticPlant {
     }
 }
 
+impl ElasticPlant {
+    /// Which limits act on a tension command `tension_n`: the motor's torque limit (reported as
+    /// an acceleration limit) when T·r exceeds it; no rate limit.
+    pub fn tension_saturation(&self, tension_n: f64) -> ReelSaturation {
+        match self.reel {
+            ReelState::Motor { drum: d, .. } => ReelSaturation {
+                rate: false,
+                accel: d.radius_m * tension_n.max(0.0) > d.max_torque_nm,
+            },
+            _ => ReelSaturation::default(),
+        }
+    }
+}
+
 impl Plant for ElasticPlant {
     fn observe(&self, command: &Command) -> Observation {
         let m = self.measure();
@@ -1221,7 +1289,10 @@ impl Plant for ElasticPlant {
             alpha_rate_radps: m.line.alpha_rate_radps,
             beta_rad: m.line.beta_rad,
             tension_n: m.tension_reel_n,
-            reel: self.reel_saturation(command.rate_mps, period),
+            reel: match command.tension_n {
+                Some(t) => self.tension_saturation(t),
+                None => self.reel_saturation(command.rate_mps, period),
+            },
             elastic: Some(ElasticObservation {
                 range_m: m.range_m,
                 tension_tip_n: m.tension_tip_n,
@@ -1235,6 +1306,7 @@ impl Plant for ElasticPlant {
 
     fn step(&mut self, command: &Command, period_s: f64) {
         self.period_hint_s = period_s;
+        self.tension_cmd_n = command.tension_n;
         // A non-finite state ends the period early; `is_finite` reports it to the loop.
         let _ = ElasticPlant::step(self, command.rate_mps, period_s);
     }

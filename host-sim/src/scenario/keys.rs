@@ -353,7 +353,7 @@ fn masked(message: &str) -> String {
 
 /// The names of the number keys that have no unit: ratios, coefficients and counts (the last
 /// part of the key; `tss-sim scenario keys` shows "-" for them).
-pub const DIMENSIONLESS_NAMES: [&str; 7] = [
+pub const DIMENSIONLESS_NAMES: [&str; 12] = [
     "eccentricity",
     "courant",
     "drag_coefficient",
@@ -361,6 +361,12 @@ pub const DIMENSIONLESS_NAMES: [&str; 7] = [
     "substeps",
     "good_samples_per_bad",
     "counts_per_rev",
+    // The tension laws' gains (`[controller.rupp]`, `[controller.tracking]`): in units of Ω.
+    "length_gain",
+    "rate_gain",
+    "bias_gain",
+    "schedule_rate",
+    "retrieve_schedule_rate",
 ];
 
 /// The unit in a key's name, by the naming convention (`_m`, `_mps`, `_rad_per_m`, `_nm`, …);

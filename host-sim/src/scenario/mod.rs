@@ -63,7 +63,9 @@ mod tests;
 
 use serde::{Deserialize, Serialize};
 
-pub use control::{ControllerSection, Stage1Section, Stage2Section};
+pub use control::{
+    ControllerSection, LawName, RuppSection, Stage1Section, Stage2Section, TrackingSection,
+};
 pub use envelope::EnvelopeSection;
 pub use environment::EnvironmentSection;
 pub use error::{Problem, ScenarioError};
@@ -160,6 +162,7 @@ impl Scenario {
         s.orbit.check(&mut v);
         s.initial.check(&mut v);
         s.initial.check_within(&s.envelope, &mut v);
+        s.controller.check(&mut v);
         s.stage1.check(&mut v);
         s.stage2.check(&s.stage1, s.controller.period_s, &mut v);
         s.simulation.check(s.controller.period_s, &mut v);
@@ -179,9 +182,17 @@ impl Scenario {
     }
 
     /// The motor reel, J2 and drag exist only in the elastic plant: asking the rigid one for
-    /// them is an error, not a silent no-op.
+    /// them is an error, not a silent no-op. On the elastic plant a tension law needs the motor
+    /// reel.
     fn check_elastic_only(&self, v: &mut Validator) {
         if self.plant.model == PlantModel::Elastic {
+            // A tension law drives the drum's torque: the elastic plant needs the drum.
+            v.check(
+                !self.controller.law.commands_tension() || self.reel.model == ReelModelName::Motor,
+                "controller.law",
+                format!("{:?}", self.controller.law.as_str()),
+                "needs reel.model = \"motor\" on the elastic plant (a tension law drives the drum)",
+            );
             return;
         }
         let needs = "needs plant.model = \"elastic\" (the rigid plant has no such model)";
