@@ -461,8 +461,9 @@ impl Figure for ConsistencyFigure<'_> {
         let root = root.titled(&self.title, (FONT, 22)).map_err(err)?;
         let panels = root.split_evenly((3, 1));
         for (area, (name, sums, dof)) in panels.iter().zip([
-            ("NEES (α, α̇), 2 dof", &self.sums.nees, NEES_DOF),
-            ("NEES (α̇), 1 dof", &self.sums.rate_nees, 1.0),
+            // The figure's font draws no combining dot: α̇ is written dα/dt.
+            ("NEES (α, dα/dt), 2 dof", &self.sums.nees, NEES_DOF),
+            ("NEES (dα/dt), 1 dof", &self.sums.rate_nees, 1.0),
             ("NIS (α), 1 dof", &self.sums.nis, NIS_DOF),
         ]) {
             panel(area, name, sums, dof).map_err(err)?;
