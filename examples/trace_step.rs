@@ -1,6 +1,6 @@
 //! # trace_step: the paper mission's steps, one call each, for instruction traces
 //!
-//! Flies `Controller<f32>` over the whole 20-hour paper mission (`tss_reel::recordings::mission`)
+//! Flies `Controller<f32>` (`Config::flight`: the law on the onboard estimator) over the whole 20-hour paper mission (`tss_reel::recordings::mission`)
 //! with one `Controller::step` call per tick and nothing else, so that an execution trace of
 //! QEMU (`tools/trace_profile.py --mission-tick N`) can attribute the instructions of any
 //! mission step, not only those of the firmware's 720-s replay. Prints nothing per step.
@@ -21,8 +21,9 @@ fn main() -> ! {
     use core::hint::black_box;
     use tss_reel::controller::{Config, Controller, Input};
 
-    let Ok(mut ctl) = Controller::new(Config::<f32>::paper()) else {
-        defmt::error!("the paper's configuration was rejected");
+    // The flight configuration (the law on the onboard estimator), as bench_step's figures.
+    let Ok(mut ctl) = Controller::new(Config::<f32>::flight()) else {
+        defmt::error!("the flight configuration was rejected");
         exit::failure();
     };
     for tick in 0..mission::TICKS {

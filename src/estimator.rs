@@ -111,12 +111,14 @@
 //! # Cost
 //!
 //! Plain scalars on the structure, not nalgebra matrices: Φ's d row is e₃ᵀ and P is symmetric,
-//! so Φ P Φᵀ is 30 multiply-adds on the 6 stored entries, and the Joseph update for H = (1 0 0)
-//! is 27; one sin_cos (of 2α̂) and two divisions a step. On the Cortex-M4F
-//! (`examples/bench_estimator.rs`, flight profile, over the paper mission) a step takes 408
-//! instructions with a sample (median; 445 at worst, in the first ticks, where the α̇
-//! variance sits at its cap), 318 in a dropout and 348 with a gated sample; nalgebra's general
-//! 3×3 forms of the two covariance products alone take 815 (Φ P Φᵀ + Q) and 1 170 (Joseph)
+//! so Φ P Φᵀ is 30 multiply-adds on the 6 stored entries; Ψ and Φ share two polynomials of the
+//! series (12 operations), and the Joseph update for H = (1 0 0), regrouped, is 15 multiply-adds;
+//! one sin_cos (of 2α̂, lent by the law in the controller) and two divisions a step. On the
+//! Cortex-M4F (`examples/bench_estimator.rs`, flight profile, over the paper mission) a step
+//! takes 355 instructions with a sample (median; 370 at worst, in the first ticks, where the α̇
+//! variance sits at its cap), 275 in a dropout and 300 with a gated sample (408/445, 318 and 348
+//! before issue 18's budget round); nalgebra's general 3×3 forms of the two covariance products
+//! alone take 815 (Φ P Φᵀ + Q) and 1 170 (Joseph)
 //! at opt-level "s".
 
 use crate::real::Real;
@@ -328,6 +330,25 @@ pub struct DriveError {
     pub value: f64,
 }
 
+/// Which of a [`Drive`]'s inputs a prediction checks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum DriveChecks {
+    /// Every input against its range ([`DriveInput`]), then the stretch: a drive from anywhere
+    /// (the public [`Estimator::predict_period`] and [`Estimator::step`]).
+    All,
+    /// The stretch alone: the length at mid-period positive and |s h| at most
+    /// [`MAX_STRETCH_PER_PERIOD`], NaN failing (so a NaN or infinite l, l̇, l̈ or μ3 is still
+    /// refused, as [`DriveInput::Stretch`] or the input it names). That is all the filter's
+    /// arithmetic needs of l, l̇, l̈ and μ3: the ranges of l and μ3 refuse only absurd values that
+    /// keep s finite. For a caller whose orbit terms are in range by construction: the
+    /// controller on a circular orbit, whose θ̇ the monitor bounds within a configured range
+    /// that lies inside (0, [`MAX_ORBIT_RATE_RADPS`]] (θ̈ = 0, μ/R³ = θ̇² > 0), and whose l is
+    /// the monitor's or the dead reckoning's, finite and in [0, the spool end].
+    // Saves the eight range checks on every controller step: scripts/bench-target, mission
+    // median 955 → 910, worst 993 → 948.
+    Stretch,
+}
+
 /// The estimate and its uncertainty.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -461,6 +482,8 @@ pub struct Estimator<T> {
     process: Sym3<T>,
     /// The variance caps of α, α̇, d.
     caps: [T; 3],
+    /// h², s² (worked out once: the prediction's k = κ h² and Φ_αd = h² w).
+    period_sq_s2: T,
     track: Option<Track<T>>,
 }
 
@@ -494,6 +517,7 @@ impl<T: Real> Estimator<T> {
                 config.initial_rate_std_radps.sq(),
                 config.initial_disturbance_std_radps2.sq(),
             ],
+            period_sq_s2: h2,
             track: None,
         })
     }
@@ -542,9 +566,20 @@ impl<T: Real> Estimator<T> {
     /// The first half of [`Estimator::step`]: carries the estimate over one period under
     /// `drive` (a caller whose calls skipped periods carries it over each, then updates once).
     pub fn predict_period(&mut self, drive: &Drive<T>) -> Prediction {
+        self.predict_period_checking(drive, DriveChecks::All)
+    }
+
+    /// [`Estimator::predict_period`] with only the `checks` of the drive (see
+    /// [`DriveChecks`]: the controller's drive, built from values it checked).
+    #[inline(always)]
+    pub(crate) fn predict_period_checking(
+        &mut self,
+        drive: &Drive<T>,
+        checks: DriveChecks,
+    ) -> Prediction {
         match &self.track {
             None => Prediction::NoEstimate,
-            Some(track) => match self.predict(track, drive) {
+            Some(track) => match self.predict(track, drive, checks) {
                 Ok(next) => {
                     self.track = Some(next);
                     Prediction::Predicted
@@ -560,7 +595,31 @@ impl<T: Real> Estimator<T> {
     /// The second half of [`Estimator::step`]: the update with this period's α sample
     /// (`None`: a dropout, nothing to do).
     pub fn update_with(&mut self, alpha_rad: Option<T>) -> Measurement<T> {
-        self.update(alpha_rad)
+        match alpha_rad {
+            None => Measurement::Missing,
+            // One comparison: false for NaN.
+            Some(z) if above_or_nan(z.abs(), T::from_f64(core::f64::consts::PI)) => {
+                Measurement::Invalid
+            }
+            Some(z) => self.update(z),
+        }
+    }
+
+    /// [`Estimator::update_with`] for an α the caller has checked to be an angle (finite,
+    /// |α| ≤ π): the controller's, from its monitor.
+    // The second range check of the same sample: with `alpha_rate_and_variance` (no whole
+    // `Estimate` built for the verdict), mission 890/920 → 875/905 (scripts/bench-target).
+    pub(crate) fn update_with_angle(&mut self, alpha_rad: Option<T>) -> Measurement<T> {
+        match alpha_rad {
+            None => Measurement::Missing,
+            Some(z) => self.update(z),
+        }
+    }
+
+    /// α̂, α̇̂ and Var(α̂), if there is an estimate (what the controller's law and its
+    /// usability test read, without the rest of [`Estimate`]).
+    pub(crate) fn alpha_rate_and_variance(&self) -> Option<(T, T, T)> {
+        self.track.as_ref().map(|t| (t.alpha, t.rate, t.p.aa))
     }
 
     /// Lends the filter sin 2α and cos 2α (computed as `(2·α).sin_cos()` in `T`) of an α the
@@ -604,7 +663,7 @@ impl<T: Real> Estimator<T> {
     ///
     /// The rate and the acceleration need no test of their own: a NaN or an infinity in
     /// either makes s NaN or infinite, and a finite but absurd one makes |s h| too large.
-    fn stretch(&self, drive: &Drive<T>) -> Result<T, DriveError> {
+    fn stretch(&self, drive: &Drive<T>, checks: DriveChecks) -> Result<T, DriveError> {
         let f = T::from_f64;
         let (l, v, a, n, mu3) = (
             drive.length_m,
@@ -621,14 +680,15 @@ impl<T: Real> Estimator<T> {
         let u = s * h;
         let orbit_max = f(MAX_ORBIT_RATE_RADPS);
         let gradient = drive.gravity_gradient_per_s2;
-        let inputs_in_range = l > T::ZERO
-            && l <= f(MAX_LENGTH_M)
-            && n > T::ZERO
-            && n <= orbit_max
-            && drive.orbit_accel_radps2.abs() <= orbit_max * orbit_max
-            && gradient > T::ZERO
-            && gradient <= orbit_max * orbit_max
-            && mu3.abs() <= f(MAX_MU3);
+        let inputs_in_range = checks == DriveChecks::Stretch
+            || l > T::ZERO
+                && l <= f(MAX_LENGTH_M)
+                && n > T::ZERO
+                && n <= orbit_max
+                && drive.orbit_accel_radps2.abs() <= orbit_max * orbit_max
+                && gradient > T::ZERO
+                && gradient <= orbit_max * orbit_max
+                && mu3.abs() <= f(MAX_MU3);
         if inputs_in_range && length_mid > T::ZERO && u.abs() <= f(MAX_STRETCH_PER_PERIOD) {
             Ok(s)
         } else {
@@ -637,9 +697,16 @@ impl<T: Real> Estimator<T> {
     }
 
     /// The estimate and covariance carried over one period (module docs, *Discretisation*).
-    fn predict(&self, t: &Track<T>, drive: &Drive<T>) -> Result<Track<T>, Prediction> {
+    fn predict(
+        &self,
+        t: &Track<T>,
+        drive: &Drive<T>,
+        checks: DriveChecks,
+    ) -> Result<Track<T>, Prediction> {
         let f = T::from_f64;
-        let s = self.stretch(drive).map_err(Prediction::InvalidDrive)?;
+        let s = self
+            .stretch(drive, checks)
+            .map_err(Prediction::InvalidDrive)?;
         let h = self.config.period_s;
         // 3μ/(2R³), and κ = (3μ/R³) cos 2α̂.
         let gradient = f(1.5) * drive.gravity_gradient_per_s2;
@@ -648,33 +715,35 @@ impl<T: Real> Estimator<T> {
         // Eq. 5b at the estimate: f(x) = (α̇, α̈, 0).
         let spin = drive.orbit_rate_radps + t.rate;
         let accel = -spin * s - gradient * sin2a - drive.orbit_accel_radps2 + t.disturbance;
-        // Ψ = φ₁(Ah) = I + Ah/2 + (Ah)²/6 + (Ah)³/24, its α and α̇ rows (its d row is e₃ᵀ,
-        // and Ψ_α̇d = Ψ_αα̇), with u = s h and k = κ h²; Ψ_α̇α enters as hΨ_α̇α (dimensionless).
+        // Ψ = φ₁(Ah) = I + Ah/2 + (Ah)²/6 + (Ah)³/24 with u = s h and k = κ h², factored on
+        // two shared polynomials (exactly the series' terms, regrouped):
+        //   c = 1/6 − u/24,   w = 1/2 − u c − k/24,
+        //   Ψ_αα = 1 − k c,  Ψ_αα̇ = Ψ_α̇d = h w,  Ψ_αd = h² c,  hΨ_α̇α = −k w,
+        //   Ψ_α̇α̇ = ψ = Ψ_αα − u w
+        // (Ψ's d row is e₃ᵀ). Φ = I + h A Ψ then reads
+        //   Φ = [ 1 − k w          h ψ              h² w ]
+        //       [ −κ h ψ           1 − k w − u ψ    h ψ  ]
+        //       [ 0                0                1    ].
+        // Regrouped: 12 operations where the series written term by term took about 40; with
+        // the Joseph update regrouped, 25 instructions less a step (scripts/bench-target,
+        // mission median 978 → 955, worst 1018 → 993).
         let u = s * h;
-        let k = stiffness * h * h;
-        let (sixth, twenty_fourth) = (f(1.0 / 6.0), f(1.0 / 24.0));
-        let psi_aa = T::ONE - k * sixth + u * k * twenty_fourth;
-        let psi_aw = h * (f(0.5) - u * sixth + (u * u - k) * twenty_fourth);
-        let psi_ad = h * h * (sixth - u * twenty_fourth);
-        let h_psi_wa = -f(0.5) * k + u * k * sixth + k * (k - u * u) * twenty_fourth;
-        let psi_ww =
-            T::ONE - f(0.5) * u + (u * u - k) * sixth + u * (f(2.0) * k - u * u) * twenty_fourth;
-        let psi_wd = psi_aw;
-        // x⁺ = x + h Ψ f(x).
-        let alpha = t.alpha + h * (psi_aa * t.rate + psi_aw * accel);
-        let rate = t.rate + h_psi_wa * t.rate + h * psi_ww * accel;
+        let k = stiffness * self.period_sq_s2;
+        let c = f(1.0 / 6.0) - u * f(1.0 / 24.0);
+        let w = f(0.5) - u * c - k * f(1.0 / 24.0);
+        let psi_aa = T::ONE - k * c;
+        let psi = psi_aa - u * w;
+        let h_psi = h * psi;
+        let phi_aa = T::ONE - k * w;
+        // x⁺ = x + h Ψ f(x): α⁺ = α + h(Ψ_αα α̇ + h w α̈), α̇⁺ = (1 − k w) α̇ + h ψ α̈.
+        let alpha = t.alpha + h * (psi_aa * t.rate + h * w * accel);
+        let rate = phi_aa * t.rate + h_psi * accel;
         if !(rate.abs() <= f(MAX_ALPHA_RATE_RADPS) && alpha.is_finite()) {
             return Err(Prediction::Diverged);
         }
-        // Φ = I + h A Ψ: its α row is e₁ᵀ + hΨ_α̇·, its α̇ row e₂ᵀ + h(−κΨ_α· − sΨ_α̇· + e₃ᵀ),
-        // its d row e₃ᵀ.
         let phi = [
-            [T::ONE + h_psi_wa, h * psi_ww, h * psi_wd],
-            [
-                -(stiffness * h * psi_aa + s * h_psi_wa),
-                T::ONE - h * (stiffness * psi_aw + s * psi_ww),
-                h * (T::ONE - stiffness * psi_ad - s * psi_wd),
-            ],
+            [phi_aa, h_psi, self.period_sq_s2 * w],
+            [-(stiffness * h * psi), phi_aa - u * psi, h_psi],
         ];
         let p =
             t.p.propagated(&phi)
@@ -691,19 +760,15 @@ impl<T: Real> Estimator<T> {
         })
     }
 
-    /// The update with this period's sample (module docs, *Gating*, *Covariance*).
-    fn update(&mut self, sample: Option<T>) -> Measurement<T> {
-        let Some(z) = sample else {
-            return Measurement::Missing;
-        };
-        if z.is_nan() || z.abs() > T::from_f64(core::f64::consts::PI) {
-            return Measurement::Invalid;
-        }
-        let Some(t) = self.track else {
+    /// The update with this period's sample (module docs, *Gating*, *Covariance*), in place.
+    /// `z`: an angle, |z| ≤ π.
+    fn update(&mut self, z: T) -> Measurement<T> {
+        let r = self.measurement_var;
+        let (gate_nis, max_rejections) = (self.config.gate_nis, self.config.max_rejections);
+        let Some(t) = &mut self.track else {
             self.track = Some(self.start(z, T::ZERO, T::ZERO));
             return Measurement::Initialised;
         };
-        let r = self.measurement_var;
         let nu = z - t.alpha;
         let var = t.p.aa + r;
         let inv = T::ONE / var;
@@ -712,28 +777,39 @@ impl<T: Real> Estimator<T> {
             variance_rad2: var,
             nis: nu * nu * inv,
         };
-        if innovation.nis > self.config.gate_nis {
-            if t.rejections >= self.config.max_rejections {
-                self.track = Some(self.start(z, t.rate, t.disturbance));
+        if innovation.nis > gate_nis {
+            if t.rejections >= max_rejections {
+                let (rate, disturbance) = (t.rate, t.disturbance);
+                self.track = Some(self.start(z, rate, disturbance));
                 return Measurement::Reinitialised(innovation);
             }
-            self.track = Some(Track {
-                rejections: t.rejections + 1,
-                ..t
-            });
+            t.rejections += 1;
             return Measurement::Gated(innovation);
         }
         // K = P Hᵀ / S, H = (1 0 0).
         let gain = [t.p.aa * inv, t.p.aw * inv, t.p.ad * inv];
-        self.track = Some(Track {
-            alpha: t.alpha + gain[0] * nu,
-            rate: t.rate + gain[1] * nu,
-            disturbance: t.disturbance + gain[2] * nu,
-            p: t.p.joseph(&gain, r),
-            rejections: 0,
-            trig: None,
-        });
+        t.alpha = t.alpha + gain[0] * nu;
+        t.rate = t.rate + gain[1] * nu;
+        t.disturbance = t.disturbance + gain[2] * nu;
+        t.p = t.p.joseph(&gain, r);
+        t.rejections = 0;
+        t.trig = None;
         Measurement::Accepted(innovation)
+    }
+}
+
+/// `v` above `cap`, or NaN: not `v ≤ cap`, in one comparison.
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN is meant to count as above
+fn above_or_nan<T: Real>(v: T, cap: T) -> bool {
+    !(v <= cap)
+}
+
+/// `v` if it is at least 0, else 0 (NaN included): `v.max(0)` in one comparison.
+fn non_negative<T: Real>(v: T) -> T {
+    if v >= T::ZERO {
+        v
+    } else {
+        T::ZERO
     }
 }
 
@@ -844,47 +920,67 @@ impl<T: Real> Sym3<T> {
     /// Each variance above its cap brought to the cap, its covariances scaled by r = cap/var
     /// (no square root): the result is D P D with D = diag(r) (1 where not capped) plus the
     /// non-negative diagonal that lifts each capped variance from r²·var back to the cap, so
-    /// it stays positive semidefinite, and the capped state's correlations shrink by √r.
+    /// it stays positive semidefinite, and the capped state's correlations shrink by √r. A NaN
+    /// variance becomes its cap (its covariances unscaled).
+    // One state at a time, dividing only for a capped one: the first steps, where α̇'s
+    // variance sits at its cap, took 45 instructions more than a nominal step with the three
+    // ratios worked out together (tools/trace_profile.py --mission-tick 1). The products are
+    // those of D P D in the same order, so the result is the same to the bit.
     fn capped(&self, caps: &[T; 3]) -> Self {
-        if self.aa <= caps[0] && self.ww <= caps[1] && self.dd <= caps[2] {
-            return *self;
+        let mut p = *self;
+        if p.aa <= caps[0] && p.ww <= caps[1] && p.dd <= caps[2] {
+            return p;
         }
-        let ratio = |var: T, cap: T| if var > cap { cap / var } else { T::ONE };
-        let r = [
-            ratio(self.aa, caps[0]),
-            ratio(self.ww, caps[1]),
-            ratio(self.dd, caps[2]),
-        ];
-        Self {
-            aa: self.aa.min(caps[0]),
-            aw: self.aw * r[0] * r[1],
-            ad: self.ad * r[0] * r[2],
-            ww: self.ww.min(caps[1]),
-            wd: self.wd * r[1] * r[2],
-            dd: self.dd.min(caps[2]),
+        if above_or_nan(p.aa, caps[0]) {
+            if p.aa > caps[0] {
+                let r = caps[0] / p.aa;
+                p.aw = p.aw * r;
+                p.ad = p.ad * r;
+            }
+            p.aa = caps[0];
         }
+        if above_or_nan(p.ww, caps[1]) {
+            if p.ww > caps[1] {
+                let r = caps[1] / p.ww;
+                p.aw = p.aw * r;
+                p.wd = p.wd * r;
+            }
+            p.ww = caps[1];
+        }
+        if above_or_nan(p.dd, caps[2]) {
+            if p.dd > caps[2] {
+                let r = caps[2] / p.dd;
+                p.ad = p.ad * r;
+                p.wd = p.wd * r;
+            }
+            p.dd = caps[2];
+        }
+        p
     }
 
-    /// The Joseph-form update (I − K e₁ᵀ) P (I − K e₁ᵀ)ᵀ + r K Kᵀ, by its upper triangle:
-    /// with B = (I − K e₁ᵀ) P, B_ij = P_ij − K_i P_0j and the result is B_ij − B_i0 K_j + r K_i K_j.
-    /// Negative rounding residue on the diagonal is cut to zero.
+    /// The Joseph-form update (I − K e₁ᵀ) P (I − K e₁ᵀ)ᵀ + r K Kᵀ, by its upper triangle.
+    /// With p = P e₁ (P's α column) and S = P_αα + r, it expands to P − K pᵀ − p Kᵀ + S K Kᵀ,
+    /// evaluated as
+    ///
+    /// ```text
+    ///   P⁺_ij = P_ij − K_i c_j − p_i K_j,    c = p − S K,
+    /// ```
+    ///
+    /// the same expression regrouped: c is K's own error (0 for the exact gain p/S), so an
+    /// error δ in K still enters P⁺ only at second order (S δδᵀ), which is what the Joseph form
+    /// is for; the short form P − K pᵀ is first order in δ. 15 multiply-adds where the product
+    /// written out took 27. Negative rounding residue on the diagonal is cut to zero.
     fn joseph(&self, k: &[T; 3], r: T) -> Self {
         let p = self;
-        let b00 = p.aa - k[0] * p.aa;
-        let b10 = p.aw - k[1] * p.aa;
-        let b20 = p.ad - k[2] * p.aa;
-        let b01 = p.aw - k[0] * p.aw;
-        let b02 = p.ad - k[0] * p.ad;
-        let b11 = p.ww - k[1] * p.aw;
-        let b12 = p.wd - k[1] * p.ad;
-        let b22 = p.dd - k[2] * p.ad;
+        let s = p.aa + r;
+        let c = [p.aa - s * k[0], p.aw - s * k[1], p.ad - s * k[2]];
         Self {
-            aa: (b00 - b00 * k[0] + r * k[0] * k[0]).max(T::ZERO),
-            aw: b01 - b00 * k[1] + r * k[0] * k[1],
-            ad: b02 - b00 * k[2] + r * k[0] * k[2],
-            ww: (b11 - b10 * k[1] + r * k[1] * k[1]).max(T::ZERO),
-            wd: b12 - b10 * k[2] + r * k[1] * k[2],
-            dd: (b22 - b20 * k[2] + r * k[2] * k[2]).max(T::ZERO),
+            aa: non_negative(p.aa - k[0] * c[0] - p.aa * k[0]),
+            aw: p.aw - k[0] * c[1] - p.aa * k[1],
+            ad: p.ad - k[0] * c[2] - p.aa * k[2],
+            ww: non_negative(p.ww - k[1] * c[1] - p.aw * k[1]),
+            wd: p.wd - k[1] * c[2] - p.aw * k[2],
+            dd: non_negative(p.dd - k[2] * c[2] - p.ad * k[2]),
         }
     }
 }
@@ -1026,6 +1122,60 @@ mod tests {
     }
 
     #[test]
+    fn the_stretch_alone_still_refuses_what_the_arithmetic_cannot_take() {
+        let good = drive(9_000.0, 1.0);
+        let refused = [
+            Drive {
+                length_m: f64::NAN,
+                ..good
+            },
+            Drive {
+                length_m: 0.0,
+                ..good
+            },
+            Drive {
+                length_m: -5.0,
+                ..good
+            },
+            Drive {
+                rate_mps: f64::INFINITY,
+                ..good
+            },
+            Drive {
+                accel_mps2: f64::NAN,
+                ..good
+            },
+            Drive {
+                mu3: f64::NAN,
+                ..good
+            },
+            Drive {
+                length_m: 1.0,
+                rate_mps: -5.0,
+                ..good
+            },
+        ];
+        for d in refused {
+            let mut e = Estimator::new(Config::paper()).unwrap();
+            e.step(&good, Some(-0.7));
+            let p = e.predict_period_checking(&d, DriveChecks::Stretch);
+            assert!(matches!(p, Prediction::InvalidDrive(_)), "{d:?}: {p:?}");
+            assert_eq!(e.estimate(), None);
+        }
+        // What both accept, both predict alike.
+        let mut all = Estimator::new(Config::paper()).unwrap();
+        all.step(&good, Some(-0.7));
+        let mut stretch = all;
+        for l in [1.0, 30.0, 9_000.0] {
+            let d = drive(l, 0.1);
+            assert_eq!(all.predict_period(&d), Prediction::Predicted);
+            let p = stretch.predict_period_checking(&d, DriveChecks::Stretch);
+            assert_eq!(p, Prediction::Predicted);
+            assert_eq!(all, stretch);
+        }
+    }
+
+    #[test]
     fn at_rest_on_the_vertical_it_stays_there() {
         // α = α̇ = 0 with the reel still is an equilibrium of Eq. 5b: the estimate does not
         // move and α̇'s variance settles.
@@ -1057,7 +1207,7 @@ mod tests {
             rate_mps: 75.0,
             ..drive(0.0, 0.0)
         };
-        let s = e.stretch(&d).unwrap();
+        let s = e.stretch(&d, DriveChecks::All).unwrap();
         assert!((s - 2.0 * 75.0 / 1037.5).abs() < 1e-15);
         let alpha = 0.3_f64;
         let kappa = 3.0 * N * N * (2.0 * alpha).cos();
@@ -1077,7 +1227,7 @@ mod tests {
             rejections: 0,
             trig: None,
         };
-        let p = e.predict(&t, &d).unwrap().p;
+        let p = e.predict(&t, &d, DriveChecks::All).unwrap().p;
         let mut x = v;
         let steps = 100_000;
         let dt = 1.0 / f64::from(steps);

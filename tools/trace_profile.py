@@ -36,6 +36,13 @@ import tempfile
 
 # (category, pattern over the inlining chain, innermost first); the first match wins.
 CATEGORIES = [
+    ("estimator: drive checks (stretch)", r"Estimator.*::stretch|estimator::refusal"),
+    ("estimator: covariance propagation (Φ P Φᵀ + Q, caps)", r"Sym3.*::(propagated|rounding_loaded|plus|capped)"),
+    ("estimator: Joseph update", r"Sym3.*::joseph"),
+    ("estimator: prediction (Ψ, Φ, the state)", r"Estimator.*::predict"),
+    ("estimator: update (gate, gain, state)", r"Estimator.*::update"),
+    ("estimator: the rest", r"estimator::"),
+    ("estimator's wiring (controller::estimation)", r"controller::estimation::|Controller.*::swing|Controller.*::commanded"),
     ("schedule (α_r: BandSchedule/SlewedSchedule)", r"schedule::|Controller.*::reference"),
     ("law::solve: fastmath::sin_cos", r"fastmath::sin_cos.*law::solve"),
     ("law::solve: fastmath::sqrt", r"sqrt.*law::solve"),
@@ -110,10 +117,13 @@ def mission_step_pcs(elf, n):
     from its entry to the return to the caller (the instruction after the caller's `bl`)."""
     nm = subprocess.run(["llvm-nm", "--defined-only", elf], capture_output=True,
                         text=True, check=True).stdout
-    entries = [int(l.split()[0], 16) & ~1 for l in nm.splitlines()
-               if "Controller" in l and "6decide17h" in l]  # Controller::decide, legacy mangling
+    # Controller::decide (legacy mangling), or Controller::run where decide is inlined into it.
+    entries = []
+    for name in ("6decide17h", "3run17h"):
+        entries = entries or [int(l.split()[0], 16) & ~1 for l in nm.splitlines()
+                              if "Controller" in l and name in l]
     if len(entries) != 1:
-        sys.exit(f"trace_profile: expected one Controller::decide in {elf}, found {len(entries)}")
+        sys.exit(f"trace_profile: expected one Controller::decide or ::run in {elf}, found {len(entries)}")
     entry = entries[0]
     with tempfile.TemporaryDirectory() as tmp:
         fifo = os.path.join(tmp, "trace.fifo")

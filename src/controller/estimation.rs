@@ -5,7 +5,9 @@
 //! it (see the controller's docs, *Flying on the estimator*).
 
 use crate::config::{estimator_error, ConfigError};
-use crate::estimator::{self, Drive, Estimate, Estimator, Measurement, Prediction};
+use crate::estimator::{
+    self, Drive, DriveChecks, Estimate, Estimator, Measurement, Prediction, MAX_ORBIT_RATE_RADPS,
+};
 use crate::monitor::Sensor;
 use crate::orbit::Orbit;
 use crate::real::Real;
@@ -68,6 +70,9 @@ pub(super) struct Estimation<T: Real> {
     eccentric: Option<Orbit<T>>,
     /// Var(α̂) beyond which the law may not use the estimate, rad².
     max_alpha_var_rad2: T,
+    /// What the filter checks of the drives this builds: the stretch alone where the orbit
+    /// terms are in range by construction (see [`Estimation::new`]), all otherwise.
+    checks: DriveChecks,
     /// The orbit's terms at the last accepted sample (a period without one is carried with
     /// them).
     orbit: Option<OrbitTerms<T>>,
@@ -82,15 +87,36 @@ pub(super) struct Estimation<T: Real> {
 }
 
 impl<T: Real> Estimation<T> {
-    /// The estimator of `cfg` (validated with the controller's configuration) on `orbit`.
-    pub(super) fn new(cfg: &estimator::Config<T>, orbit: &Orbit<T>) -> Result<Self, ConfigError> {
+    /// The estimator of `cfg` (validated with the controller's configuration) on `orbit`, with
+    /// samples whose θ̇ the monitor bounds to `orbit_rate_range_radps` (validated: positive).
+    ///
+    /// The drives it builds have the filter check the stretch alone ([`DriveChecks::Stretch`])
+    /// when their orbit terms are in the filter's ranges by construction: a circular orbit
+    /// (θ̈ = 0, μ/R³ = θ̇²) with θ̇ at most [`MAX_ORBIT_RATE_RADPS`] and θ̇² > 0 in `T` over the
+    /// whole range. On an eccentric orbit θ̈ and μ/R³ come from the sensed θ, which nothing
+    /// bounds: the filter checks every input.
+    pub(super) fn new(
+        cfg: &estimator::Config<T>,
+        orbit: &Orbit<T>,
+        orbit_rate_range_radps: (T, T),
+    ) -> Result<Self, ConfigError> {
         let filter = Estimator::new(*cfg).map_err(estimator_error)?;
         let max_alpha_var_rad2 =
             T::from_f64(MAX_ALPHA_VARIANCE_IN_SAMPLES) * filter.measurement_var_rad2();
+        let eccentric = (orbit.eccentricity > T::ZERO).then_some(*orbit);
+        let (min, max) = orbit_rate_range_radps;
+        let in_range = min > T::ZERO && min * min > T::ZERO;
+        let checks = if eccentric.is_none() && in_range && max <= T::from_f64(MAX_ORBIT_RATE_RADPS)
+        {
+            DriveChecks::Stretch
+        } else {
+            DriveChecks::All
+        };
         Ok(Self {
             filter,
-            eccentric: (orbit.eccentricity > T::ZERO).then_some(*orbit),
+            eccentric,
             max_alpha_var_rad2,
+            checks,
             orbit: None,
             commanded: None,
             nis: None,
@@ -147,8 +173,9 @@ impl<T: Real> Estimation<T> {
             let last_lost = periods > 0 && self.carry(periods - 1, reel_rate_mps);
             gap_lost || last_lost
         };
-        let m = self.filter.update_with(alpha_rad);
-        let estimate = self.filter.estimate();
+        // The monitor checked α: |α| ≤ π.
+        let m = self.filter.update_with_angle(alpha_rad);
+        let estimate = self.filter.alpha_rate_and_variance();
         let (nis, event) = match m {
             Measurement::Accepted(i) | Measurement::Gated(i) => (Some(i.nis), None),
             Measurement::Reinitialised(i) => (Some(i.nis), Some(EventKind::EstimateRestarted)),
@@ -166,10 +193,12 @@ impl<T: Real> Estimation<T> {
         ) {
             self.useless = false;
         }
-        let verdict = match (m, &estimate) {
+        let verdict = match (m, estimate) {
             (Measurement::Gated(_), _) => Estimated::Unusable(Sensor::AlphaGated),
-            (_, Some(e)) if !self.useless && e.alpha_var_rad2 <= self.max_alpha_var_rad2 => {
-                Estimated::Usable(e.alpha_rad, e.alpha_rate_radps)
+            (_, Some((alpha_rad, alpha_rate_radps, alpha_var_rad2)))
+                if !self.useless && alpha_var_rad2 <= self.max_alpha_var_rad2 =>
+            {
+                Estimated::Usable(alpha_rad, alpha_rate_radps)
             }
             _ => {
                 self.useless = true;
@@ -184,7 +213,7 @@ impl<T: Real> Estimation<T> {
     fn carry(&mut self, k: u32, reel_rate_mps: Option<T>) -> bool {
         match self.drive(k, reel_rate_mps) {
             Some(drive) => matches!(
-                self.filter.predict_period(&drive),
+                self.filter.predict_period_checking(&drive, self.checks),
                 Prediction::InvalidDrive(_) | Prediction::Diverged
             ),
             None => {
@@ -254,15 +283,44 @@ impl<T: Real> Estimation<T> {
 mod tests {
     use super::*;
 
+    /// The monitor's default θ̇ range.
+    const RATES: (f64, f64) = (1e-5, 1e-2);
+
+    #[test]
+    fn the_filter_checks_the_stretch_alone_only_where_the_orbit_terms_are_in_range() {
+        let cfg = estimator::Config::<f64>::paper();
+        let circular = Orbit::circular(7_078_000.0);
+        let checks =
+            |orbit: &Orbit<f64>, rates| Estimation::new(&cfg, orbit, rates).unwrap().checks;
+        assert_eq!(checks(&circular, RATES), DriveChecks::Stretch);
+        assert_eq!(
+            checks(&circular, (1e-3, MAX_ORBIT_RATE_RADPS)),
+            DriveChecks::Stretch
+        );
+        // A θ̇ the filter refuses could pass the monitor: every input is checked.
+        assert_eq!(
+            checks(&circular, (1e-3, 2.0 * MAX_ORBIT_RATE_RADPS)),
+            DriveChecks::All
+        );
+        // θ̇² would underflow to 0 at the bottom of the range (in f32 too: 1e-30² < 1e-45).
+        let est32 = estimator::Config::<f32>::paper();
+        let tiny = Estimation::new(&est32, &Orbit::circular(7_078_000.0), (1e-30, 2e-3)).unwrap();
+        assert_eq!(tiny.checks, DriveChecks::All);
+        assert_eq!(
+            checks(&Orbit::elliptic(7_078_000.0, 0.1), RATES),
+            DriveChecks::All
+        );
+    }
+
     #[test]
     fn the_drive_takes_the_orbit_terms_from_theta_on_an_eccentric_orbit_only() {
         let cfg = estimator::Config::<f64>::paper();
-        let circular = Estimation::new(&cfg, &Orbit::circular(7_078_000.0)).unwrap();
+        let circular = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), RATES).unwrap();
         let n = 1.06e-3;
         let t = circular.orbit_terms(n, 2.0);
         assert_eq!((t.accel_radps2, t.gravity_gradient_per_s2), (0.0, n * n));
         let orbit = Orbit::elliptic(7_078_000.0, 0.1);
-        let eccentric = Estimation::new(&cfg, &orbit).unwrap();
+        let eccentric = Estimation::new(&cfg, &orbit, RATES).unwrap();
         let theta = 2.0;
         let t = eccentric.orbit_terms(n, theta);
         assert_eq!(t.rate_radps, n);
@@ -277,7 +335,7 @@ mod tests {
     #[test]
     fn the_drive_is_the_last_command_or_the_measured_mean_rate() {
         let cfg = estimator::Config::<f64>::paper();
-        let mut e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0)).unwrap();
+        let mut e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), RATES).unwrap();
         assert_eq!(e.drive(0, None), None);
         e.orbit = Some(e.orbit_terms(1.06e-3, 0.0));
         e.commanded(Commanded {

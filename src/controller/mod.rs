@@ -133,7 +133,13 @@ impl<T: Real> Controller<T> {
         let spool_m = T::from_f64(cfg.envelope.max_length_m.to_f64() * (1.0 + SPOOL_MARGIN));
         let estimation = match &cfg.rate_source {
             RateSource::Sensor => None,
-            RateSource::Estimator(est) => Some(Estimation::new(est, &cfg.orbit)?),
+            RateSource::Estimator(est) => {
+                let rates = (
+                    cfg.monitor.min_orbit_rate_radps,
+                    cfg.monitor.max_orbit_rate_radps,
+                );
+                Some(Estimation::new(est, &cfg.orbit, rates)?)
+            }
         };
         Ok(Self {
             envelope: PreparedEnvelope::new(cfg.envelope),
