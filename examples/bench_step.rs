@@ -190,6 +190,7 @@ mod bench {
                 angle: stage1.eval(l),
                 time_rate_radps: 0.0,
                 slewing: false,
+                orbit: None,
             }
         };
         let (decay, initial) = if stage2 {
@@ -204,6 +205,7 @@ mod bench {
             alpha_rad: out.alpha_ref_rad + out.delta_rad,
             alpha_rate_radps: out.alpha_ref_rate_radps + out.delta_rate_radps,
             orbit_rate_radps: x.orbit_rate_radps,
+            orbit: None,
             ref_angle_rad: reference.angle.angle_rad,
             ref_slope_rad_per_m: reference.angle.slope_rad_per_m,
             ref_curvature_rad_per_m2: reference.angle.curvature_rad_per_m2,

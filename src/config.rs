@@ -4,6 +4,7 @@
 //! by [`crate::controller::Controller::new`]): a controller that exists is a valid one. Errors
 //! are typed and name the parameter (its path in [`Config`]) and the value.
 
+use crate::controller::ProtectionConfig;
 use crate::envelope::Envelope;
 use crate::estimator;
 use crate::law::Gains;
@@ -155,6 +156,9 @@ pub struct Config<T> {
     pub envelope: Envelope<T>,
     /// Sensor checks and fault timing.
     pub monitor: MonitorConfig<T>,
+    /// Tension- and drive-aware protection (docs/equations.md §14); `None`: the paper's
+    /// controller, bounded by the envelope alone.
+    pub protection: Option<ProtectionConfig<T>>,
     /// Where the law's α and α̇ come from.
     pub rate_source: RateSource<T>,
 }
@@ -206,6 +210,7 @@ impl<T: Real> Config<T> {
                 max_length_m: T::from_f64(40_000.0),
             },
             monitor: MonitorConfig::default_for_period(),
+            protection: None,
             rate_source: RateSource::Sensor,
         }
     }
@@ -284,6 +289,9 @@ impl<T: Real> Config<T> {
         positive("keep_capture_m", self.keep_capture_m)?;
         let env = &self.envelope;
         self.monitor.validate()?;
+        if let Some(p) = &self.protection {
+            p.validate(self.period_s)?;
+        }
         positive("envelope.max_rate_mps", env.max_rate_mps)?;
         positive("envelope.max_accel_mps2", env.max_accel_mps2)?;
         positive("envelope.min_length_m", env.min_length_m)?;

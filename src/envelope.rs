@@ -17,7 +17,14 @@
 //! period, would ask for up to 1.8 a). The distance
 //! is measured to the limit less a guard of [`LENGTH_GUARD_REL`] × the limit, which covers the
 //! f32 rounding of the sensed length.
+//!
+//! With the controller's protection (`crate::controller::ProtectionConfig`, docs/equations.md
+//! §14) two more bounds enter: the tension bound, a window of commands inside the acceleration
+//! window (the acceleration limit wins where they disagree), and the drive's overrun: a drive
+//! with lag τ runs τ|v| beyond the commands before it stops, so the distance to a length limit
+//! is measured less that overrun, which makes the staircase exact for the drive.
 
+use crate::controller::protection::Bounds;
 use crate::real::Real;
 
 /// Guard kept from each length limit, relative to the limit (≈ one f32 ulp: 3.6 mm at 30 km),
@@ -50,6 +57,8 @@ impl Saturation {
     pub const ACCEL: u32 = 1 << 1;
     /// A length limit (docking or spool) acted.
     pub const LENGTH: u32 = 1 << 2;
+    /// The tension bound of the protection acted.
+    pub const TENSION: u32 = 1 << 9;
 
     /// The speed limit acted.
     pub fn rate(self) -> bool {
@@ -62,6 +71,10 @@ impl Saturation {
     /// A length limit acted.
     pub fn length(self) -> bool {
         self.0 & Self::LENGTH != 0
+    }
+    /// The tension bound acted.
+    pub fn tension(self) -> bool {
+        self.0 & Self::TENSION != 0
     }
     /// Some limit acted.
     pub fn any(self) -> bool {
@@ -88,14 +101,20 @@ impl<T: Real> Envelope<T> {
         } else {
             requested_mps
         };
-        PreparedEnvelope::new(*self).limit_request(requested_mps, previous_mps, length_m, dt_s)
+        PreparedEnvelope::new(*self).limit_request(
+            requested_mps,
+            previous_mps,
+            length_m,
+            dt_s,
+            &Bounds::none(),
+        )
     }
 
     /// The largest speed toward a limit `room_m` away from which the reel can still stop at
-    /// it, decelerating by at most a·Δt per period (see the module docs).
-    fn braking_speed(&self, room_m: T, dt_s: T) -> T {
+    /// it, decelerating by at most `accel_mps2`·Δt per period (see the module docs).
+    fn braking_speed(room_m: T, dt_s: T, accel_mps2: T) -> T {
         let half = T::from_f64(0.5);
-        let dv = self.max_accel_mps2 * dt_s;
+        let dv = accel_mps2 * dt_s;
         let m = ((T::from_f64(0.25) + T::from_f64(2.0) * room_m / (dv * dt_s)).sqrt() - half)
             .max(T::ZERO)
             .floor();
@@ -135,12 +154,17 @@ impl<T: Real> PreparedEnvelope<T> {
     // Inlined into the step: 13 instructions less on a nominal step
     // (tools/trace_profile.py, replay tick 301: 664 → 651).
     #[inline(always)]
+    ///
+    /// `bounds` are the protection's: the tension window (inside the acceleration window: the
+    /// acceleration limit wins) and the drive's overrun, by which the room to each length limit
+    /// is shortened.
     pub(crate) fn limit_request(
         &self,
         requested_mps: T,
         previous_mps: T,
         length_m: T,
         dt_s: T,
+        bounds: &Bounds<T>,
     ) -> (T, Saturation) {
         let env = &self.env;
         let mut sat = Saturation::default();
@@ -155,24 +179,38 @@ impl<T: Real> PreparedEnvelope<T> {
             sat.0 |= Saturation::ACCEL;
             y = y.clamp_to(previous_mps - dv, previous_mps + dv);
         }
+        if let Some((lo, hi)) = bounds.tension_rate_mps {
+            let (lo, hi) = (lo.min(previous_mps + dv), hi.max(previous_mps - dv));
+            if y > hi || y < lo {
+                sat.0 |= Saturation::TENSION;
+                y = y.clamp_to(lo, hi);
+            }
+        }
         // Only the length limit ahead of the motion can bind: the spool end when paying out,
         // docking when winding in. Far from it (the braking distance at y, plus two periods,
         // fits in the room left) the command passes as it is. (A negative room, past the
         // limit, is never far for a speed toward it; the braking curve sees it as zero.)
+        // A lagging drive brakes on a staircase of a·(1 − e^{−h})/h per period: its peak
+        // acceleration, just after each step, is then a (docs/equations.md §14).
         let two = T::from_f64(2.0);
-        let far = |v: T, room: T| v * (v / self.two_accel_mps2 + two * dt_s) <= room;
+        let brake_mps2 = env.max_accel_mps2 * bounds.braking_fraction;
+        let far = |v: T, room: T| {
+            v * (v / (self.two_accel_mps2 * bounds.braking_fraction) + two * dt_s) <= room
+        };
         let (up, down) = if y > T::ZERO {
-            let up_room = self.spool_guarded_m - length_m;
+            let up_room = self.spool_guarded_m - length_m - bounds.overrun_out_m;
             if far(y, up_room) {
                 return (Self::settle(y, vmax, sat), sat);
             }
-            (env.braking_speed(up_room.max(T::ZERO), dt_s), -vmax)
+            let up = Envelope::braking_speed(up_room.max(T::ZERO), dt_s, brake_mps2);
+            (up, -vmax)
         } else if y < T::ZERO {
-            let down_room = length_m - self.dock_guarded_m;
+            let down_room = length_m - self.dock_guarded_m - bounds.overrun_in_m;
             if far(-y, down_room) {
                 return (Self::settle(y, vmax, sat), sat);
             }
-            (vmax, -env.braking_speed(down_room.max(T::ZERO), dt_s))
+            let down = Envelope::braking_speed(down_room.max(T::ZERO), dt_s, brake_mps2);
+            (vmax, -down)
         } else {
             // Zero (or NaN, when `previous_mps` is: the documented fallback is −vmax).
             return (y.clamp_to(-vmax, vmax), sat);
@@ -191,10 +229,46 @@ impl<T: Real> PreparedEnvelope<T> {
         (y.clamp_finite(-vmax, vmax), sat)
     }
 
+    /// The acceleration reported with a command `rate_mps` that followed `previous_mps`: a
+    /// limited command's slope over the period; otherwise Eq. 30's `eq30_mps2`, bounded like
+    /// every commanded quantity (Eq. 30 is the law's derivative, which leaves the envelope where
+    /// the law's rate jumps, a blend restart from a held rate) by the acceleration limit and by
+    /// the tension bound (the acceleration limit wins). With an ideal reel it is the l̈ of
+    /// Eq. 5a's tension (the paper's Fig. 4).
+    #[inline(always)]
+    pub(crate) fn commanded_accel(
+        &self,
+        eq30_mps2: T,
+        rate_mps: T,
+        previous_mps: T,
+        dt_s: T,
+        sat: Saturation,
+        bounds: &Bounds<T>,
+    ) -> (T, Saturation) {
+        if sat.any() {
+            return ((rate_mps - previous_mps) / dt_s, Saturation::default());
+        }
+        let amax = self.env.max_accel_mps2;
+        let mut a = eq30_mps2;
+        let mut sat = Saturation::default();
+        if a.abs() > amax {
+            sat.0 |= Saturation::ACCEL;
+            a = a.clamp_finite(-amax, amax);
+        }
+        if let Some((lo, hi)) = bounds.tension_accel_mps2 {
+            let (lo, hi) = (lo.min(amax), hi.max(-amax));
+            if a > hi || a < lo {
+                sat.0 |= Saturation::TENSION;
+                a = a.clamp_finite(lo, hi);
+            }
+        }
+        (a, sat)
+    }
+
     /// The command when no length limit acts: `y` is already within ±`vmax` unless the
     /// acceleration clamp moved it (toward a `previous_mps` that could lie outside).
     fn settle(y: T, vmax: T, sat: Saturation) -> T {
-        if sat.accel() {
+        if sat.accel() || sat.tension() {
             y.clamp_finite(-vmax, vmax)
         } else {
             y

@@ -20,6 +20,17 @@
 //! ```
 //!
 //! taking the physical root y = 2C/(b + √(b² − 4pC)), the one that tends to C/b as p → 0.
+//!
+//! **Eccentric orbits** (docs/equations.md §16). With [`LawInput::orbit`] set, n is θ̇, the
+//! gravity-gradient factor 1.5n² becomes 1.5μ/R³, and the numerator also takes Eq. 5b's θ̈ and
+//! the reference's explicit time acceleration ∂²α_r/∂t² (the forced libration it follows):
+//!
+//! ```text
+//!   l̇ = [k1 δ̇ + k2 δ − 1.5(μ/R³) sin 2α − θ̈ − ∂²α_r/∂t²] / (θ̇ + δ̇) · l/(2 + μ3)
+//! ```
+//!
+//! so that a tether on the reference's periodic libration at constant length needs l̇ = 0. With
+//! `orbit: None` (a circular orbit) every operation is the paper's, bit for bit.
 
 use crate::real::Real;
 
@@ -80,6 +91,28 @@ impl<T: Real> Blend<T> {
     }
 }
 
+/// The eccentric-orbit terms of Eqs. 27 and 30 at one instant (docs/equations.md §16.3): the
+/// orbit's (§0) and those of a reference that moves with θ (§16.2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OrbitForcing<T> {
+    /// 1.5 μ/R³, 1/s² (1.5 n² on a circular orbit).
+    pub gradient_per_s2: T,
+    /// d(1.5 μ/R³)/dt, 1/s³.
+    pub gradient_rate_per_s3: T,
+    /// θ̈, rad/s².
+    pub orbit_accel_radps2: T,
+    /// θ⃛, rad/s³.
+    pub orbit_jerk_radps3: T,
+    /// ∂²α_r/∂t² at fixed l, rad/s².
+    pub ref_time_accel_radps2: T,
+    /// ∂³α_r/∂t³ at fixed l, rad/s³.
+    pub ref_time_jerk_radps3: T,
+    /// ∂²α_r/∂l∂t, rad/(m·s).
+    pub ref_slope_rate_rad_per_m_s: T,
+    /// ∂³α_r/∂l∂t², rad/(m·s²).
+    pub ref_time_accel_slope_rad_per_m_s2: T,
+}
+
 /// Everything the law needs at one instant.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LawInput<T> {
@@ -89,8 +122,11 @@ pub struct LawInput<T> {
     pub alpha_rad: T,
     /// In-plane rate α̇, rad/s.
     pub alpha_rate_radps: T,
-    /// Orbit rate n, rad/s.
+    /// Orbit rate n (θ̇ on an eccentric orbit), rad/s.
     pub orbit_rate_radps: T,
+    /// The eccentric-orbit terms (docs/equations.md §16); `None` on a circular orbit, where the
+    /// law is the paper's, bit for bit.
+    pub orbit: Option<OrbitForcing<T>>,
     /// α_r, rad.
     pub ref_angle_rad: T,
     /// p = ∂α_r/∂l, rad/m.
@@ -149,7 +185,8 @@ pub struct LawOutput<T> {
     pub cos_two_alpha: T,
     /// L′ = l/(2 + μ3), m, reused by [`acceleration`].
     pub reduced_length_m: T,
-    /// 1.5 n², the gravity-gradient factor of Eq. 27, 1/s², reused by [`acceleration`].
+    /// 1.5 n² (1.5 μ/R³ on an eccentric orbit), the gravity-gradient factor of Eq. 27, 1/s²,
+    /// reused by [`acceleration`].
     pub gradient_per_s2: T,
     /// N/D = l̇/L′, the Eq. 27 fraction, 1/s, reused by [`acceleration`].
     pub fraction_per_s: T,
@@ -175,8 +212,18 @@ pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
     let delta = x.alpha_rad - x.ref_angle_rad;
     // sin(2δ + 2α_r) = sin 2α.
     let (sin2a, cos2a) = (two * x.alpha_rad).sin_cos();
-    let gradient = three_halves * n * n;
-    let gravity = gradient * sin2a;
+    // The restoring terms of Eq. 5b that the numerator cancels: 1.5n² sin 2α, and on an
+    // eccentric orbit 1.5(μ/R³) sin 2α + θ̈ + ∂²α_r/∂t² (docs/equations.md §16.3).
+    let (gradient, gravity) = match &x.orbit {
+        None => {
+            let gradient = three_halves * n * n;
+            (gradient, gradient * sin2a)
+        }
+        Some(o) => (
+            o.gradient_per_s2,
+            o.gradient_per_s2 * sin2a + o.orbit_accel_radps2 + o.ref_time_accel_radps2,
+        ),
+    };
     let w = n + x.alpha_rate_radps - x.ref_time_rate_radps;
     let g0 =
         k1 * (x.alpha_rate_radps - x.ref_time_rate_radps) + x.gains.k2_per_s2 * delta - gravity;
@@ -220,7 +267,8 @@ pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
     })
 }
 
-/// Eq. 27 evaluated explicitly for a given δ̇ (rad/s), in the paper's form:
+/// Eq. 27 evaluated explicitly for a given δ̇ (rad/s), in the paper's form (with the
+/// eccentric-orbit terms of docs/equations.md §16.3 when [`LawInput::orbit`] is set):
 ///
 /// ```text
 ///   l̇ = [k1 δ̇ + k2 δ − 1.5 n² sin(2δ + 2α_r)] / (n + δ̇) · l/(2 + μ3),   δ = α − α_r.
@@ -238,6 +286,7 @@ pub fn solve<T: Real>(x: &LawInput<T>) -> Result<LawOutput<T>, LawFault> {
 ///     alpha_rad: -0.6,
 ///     alpha_rate_radps: 1.0e-4,
 ///     orbit_rate_radps: 1.06e-3,
+///     orbit: None,
 ///     ref_angle_rad: -0.55,
 ///     ref_slope_rad_per_m: 6.0e-5,
 ///     ref_curvature_rad_per_m2: 3.0e-9,
@@ -257,8 +306,12 @@ pub fn explicit_eq27<T: Real>(x: &LawInput<T>, delta_rate_radps: T) -> T {
     let two = T::from_f64(2.0);
     let delta = x.alpha_rad - x.ref_angle_rad;
     let n = x.orbit_rate_radps;
-    (x.gains.k1_per_s * delta_rate_radps + x.gains.k2_per_s2 * delta
-        - T::from_f64(1.5) * n * n * (two * delta + two * x.ref_angle_rad).sin())
+    let sin2a = (two * delta + two * x.ref_angle_rad).sin();
+    let restoring = match &x.orbit {
+        None => T::from_f64(1.5) * n * n * sin2a,
+        Some(o) => o.gradient_per_s2 * sin2a + o.orbit_accel_radps2 + o.ref_time_accel_radps2,
+    };
+    (x.gains.k1_per_s * delta_rate_radps + x.gains.k2_per_s2 * delta - restoring)
         / (n + delta_rate_radps)
         * x.length_m
         / (two + x.mu3)
@@ -286,13 +339,28 @@ pub fn acceleration<T: Real>(x: &LawInput<T>, s: &LawOutput<T>) -> Result<T, Law
     // u̇ = (L′/D)[(k1 − N/D) δ̈ + k2 δ̇ − 3n² α̇ cos2α] + u (y/l − μ̇3/(2+μ3)).
     let k_eff = x.gains.k1_per_s - s.fraction_per_s;
     let b_coef = one_minus_e * l_prime / d * k_eff;
-    let rest = l_prime / d
-        * (x.gains.k2_per_s2 * s.delta_rate_radps
-            - two * s.gradient_per_s2 * x.alpha_rate_radps * s.cos_two_alpha)
-        + u * (y / l - mu3_dot / (two + x.mu3));
+    let mut numerator_rate = x.gains.k2_per_s2 * s.delta_rate_radps
+        - two * s.gradient_per_s2 * x.alpha_rate_radps * s.cos_two_alpha;
+    // δ̈ without its p ÿ part: α̈ − q y² (and on an eccentric orbit − 2 (∂²α_r/∂l∂t) y − ∂²α_r/∂t²).
+    let mut delta_accel = alpha_accel - x.ref_curvature_rad_per_m2 * y * y;
+    if let Some(o) = &x.orbit {
+        // docs/equations.md §16.5: Eq. 5b's θ̈ in α̈; Ṅ's −d(1.5μ/R³)/dt sin 2α − θ⃛ − d(∂²α_r/∂t²)/dt;
+        // Ḋ's θ̈ (D = θ̇ + δ̇), which enters u̇ as −(N/D) θ̈.
+        delta_accel = delta_accel
+            - o.orbit_accel_radps2
+            - two * o.ref_slope_rate_rad_per_m_s * y
+            - o.ref_time_accel_radps2;
+        numerator_rate = numerator_rate
+            - o.gradient_rate_per_s3 * s.sin_two_alpha
+            - o.orbit_jerk_radps3
+            - o.ref_time_jerk_radps3
+            - o.ref_time_accel_slope_rad_per_m_s2 * y
+            - s.fraction_per_s * o.orbit_accel_radps2;
+    }
+    let rest = l_prime / d * numerator_rate + u * (y / l - mu3_dot / (two + x.mu3));
     let a = x.decay_rate_per_s * e * (u - x.initial_rate_mps)
         + one_minus_e * rest
-        + b_coef * (alpha_accel - x.ref_curvature_rad_per_m2 * y * y);
+        + b_coef * delta_accel;
     let fold = T::ONE + b_coef * x.ref_slope_rad_per_m;
     if fold.abs() < T::from_f64(1e-3) {
         return Err(LawFault::AccelerationSingular);
@@ -311,12 +379,17 @@ mod tests {
 
     const N: f64 = 1.060_237_230_236_363_5e-3;
 
+    fn base_input() -> LawInput<f64> {
+        base()
+    }
+
     fn base() -> LawInput<f64> {
         LawInput {
             length_m: 15_000.0,
             alpha_rad: -0.6,
             alpha_rate_radps: 1.0e-4,
             orbit_rate_radps: N,
+            orbit: None,
             ref_angle_rad: -0.55,
             ref_slope_rad_per_m: 6.0e-5,
             ref_curvature_rad_per_m2: 3.0e-9,
@@ -448,6 +521,163 @@ mod tests {
         };
         let fd = (step(dt) - step(-dt)) / (2.0 * dt);
         assert!((a0 - fd).abs() < 1e-6 * fd.abs() + 1e-12, "{a0} vs {fd}");
+    }
+
+    /// A state on an eccentric orbit (e = 0.2) `h` seconds after a start state, moved along
+    /// Eq. 5b with l̇ = the start state's command (to first order: central differences cancel
+    /// the second-order terms), its reference and orbit terms worked out from the stage-1 band
+    /// (or the stage-2 slew) and the orbit.
+    fn eccentric_state(h: f64, slewing: bool) -> LawInput<f64> {
+        use crate::orbit::Orbit;
+        use crate::schedule::{BandSchedule, LibratingReference, Reference};
+        let orbit = Orbit::elliptic(7.8e6, 0.2);
+        let prepared = orbit.prepare();
+        let librating = LibratingReference::new(&orbit).unwrap();
+        let band = BandSchedule::<f64>::paper_stage1().prepare();
+        let (theta0, l0, alpha0, alpha_rate0, tau0) = (1.1, 24_000.0, -0.3, 2.0e-4, 200.0);
+        let state = |theta: f64, l: f64, alpha: f64, alpha_rate: f64, tau: f64, e: f64| {
+            let base = if slewing {
+                band.eval_slewed(6.2932e-4, tau, l)
+            } else {
+                Reference {
+                    angle: band.eval(l),
+                    time_rate_radps: 0.0,
+                    slewing: false,
+                    orbit: None,
+                }
+            };
+            let r = librating.eval(base, theta);
+            LawInput {
+                length_m: l,
+                alpha_rad: alpha,
+                alpha_rate_radps: alpha_rate,
+                orbit_rate_radps: prepared.at(theta).rate_radps,
+                orbit: r.orbit,
+                ref_angle_rad: r.angle.angle_rad,
+                ref_slope_rad_per_m: r.angle.slope_rad_per_m,
+                ref_curvature_rad_per_m2: r.angle.curvature_rad_per_m2,
+                ref_time_rate_radps: r.time_rate_radps,
+                mu3: 0.05,
+                mu3_per_m: 0.0,
+                blend: Blend::from_weight(e),
+                decay_rate_per_s: 1e-3,
+                initial_rate_mps: 0.1,
+                gains: Gains::paper(),
+            }
+        };
+        let x0 = state(theta0, l0, alpha0, alpha_rate0, tau0, 0.3);
+        let y0 = solve(&x0).unwrap().rate_mps;
+        let o0 = prepared.at(theta0);
+        let alpha_ddot = -(o0.rate_radps + alpha_rate0) * y0 / (l0 / 2.05)
+            - 1.5 * o0.gravity_gradient_per_s2 * (2.0 * alpha0).sin()
+            - o0.accel_radps2;
+        state(
+            theta0 + o0.rate_radps * h,
+            l0 + y0 * h,
+            alpha0 + alpha_rate0 * h,
+            alpha_rate0 + alpha_ddot * h,
+            tau0 + h,
+            0.3 * (-1e-3 * h).exp(),
+        )
+    }
+
+    #[test]
+    fn eccentric_acceleration_is_the_time_derivative_of_the_command() {
+        // Eq. 30 on an eccentric orbit (docs/equations.md §16.5), on the band and in the slew:
+        // ÿ against a central difference of the command along the motion.
+        for slewing in [false, true] {
+            let x0 = eccentric_state(0.0, slewing);
+            let a0 = acceleration(&x0, &solve(&x0).unwrap()).unwrap();
+            let dt = 1e-2;
+            let y = |h: f64| solve(&eccentric_state(h, slewing)).unwrap().rate_mps;
+            let fd = (y(dt) - y(-dt)) / (2.0 * dt);
+            assert!(
+                (a0 - fd).abs() < 1e-6 * fd.abs() + 1e-12,
+                "slewing {slewing}: {a0} vs {fd}"
+            );
+        }
+    }
+
+    #[test]
+    fn on_the_libration_at_the_keep_the_command_is_zero() {
+        // At the stage-1 keep (α_r = 0), a tether on the periodic libration (α = P(θ),
+        // α̇ = θ̇ P′) at rest needs no reel motion: y = 0 at every θ, the residual at rounding.
+        use crate::orbit::Orbit;
+        use crate::schedule::{BandSchedule, LibratingReference, Reference};
+        for e in [0.1, 0.3] {
+            let mut fought: f64 = 0.0;
+            let orbit = Orbit::elliptic(10.0e6, e);
+            let prepared = orbit.prepare();
+            let librating = LibratingReference::new(&orbit).unwrap();
+            let band = BandSchedule::<f64>::paper_stage1().prepare();
+            for theta in [0.0, 0.5, 2.0, 3.0, 4.5] {
+                let base = Reference {
+                    angle: band.eval(30_000.0),
+                    time_rate_radps: 0.0,
+                    slewing: false,
+                    orbit: None,
+                };
+                let r = librating.eval(base, theta);
+                let p = librating.libration().eval(theta);
+                let rate = prepared.at(theta).rate_radps;
+                let x = LawInput {
+                    length_m: 30_000.0,
+                    alpha_rad: p.angle_rad,
+                    alpha_rate_radps: rate * p.slope,
+                    orbit_rate_radps: rate,
+                    orbit: r.orbit,
+                    ref_angle_rad: r.angle.angle_rad,
+                    ref_slope_rad_per_m: r.angle.slope_rad_per_m,
+                    ref_curvature_rad_per_m2: r.angle.curvature_rad_per_m2,
+                    ref_time_rate_radps: r.time_rate_radps,
+                    blend: Blend::from_weight(0.0),
+                    mu3: 0.0,
+                    ..base_input()
+                };
+                let s = solve(&x).unwrap();
+                // (The series' residual, ≤ 1e-9 in α″, times L′θ̇: ≲ 1e-8 m/s.)
+                assert!(
+                    s.rate_mps.abs() < 1e-7,
+                    "e = {e}, θ = {theta}: {}",
+                    s.rate_mps
+                );
+                // Today's law (no orbit terms, α_r = 0) fights the libration with the reel.
+                let circular = LawInput {
+                    orbit: None,
+                    ref_angle_rad: 0.0,
+                    ref_time_rate_radps: 0.0,
+                    ..x
+                };
+                // (or has no solution: a singular denominator counts as fighting.)
+                let y = solve(&circular).map_or(f64::INFINITY, |s| s.rate_mps.abs());
+                fought = fought.max(y);
+            }
+            assert!(fought > 0.5, "e = {e}: {fought} m/s");
+        }
+    }
+
+    #[test]
+    fn an_unknown_true_anomaly_is_a_fault_not_a_number() {
+        // θ not finite on an eccentric orbit: the reference carries NaN orbit terms and the law
+        // faults (the controller's safe action), whatever the rest of the state.
+        use crate::schedule::{LibratingReference, Reference};
+        let base = Reference {
+            angle: crate::schedule::RefAngle {
+                angle_rad: -0.55,
+                slope_rad_per_m: 6.0e-5,
+                curvature_rad_per_m2: 3.0e-9,
+            },
+            time_rate_radps: 0.0,
+            slewing: false,
+            orbit: None,
+        };
+        let r = LibratingReference::without_anomaly(base);
+        assert_eq!(r.angle, base.angle);
+        let x = LawInput {
+            orbit: r.orbit,
+            ..base_input()
+        };
+        assert_eq!(solve(&x), Err(LawFault::NotFinite));
     }
 
     #[test]

@@ -790,6 +790,7 @@ pub fn config_digest(cfg: &crate::controller::Config<f32>) -> u32 {
         keep_capture_m,
         envelope,
         monitor,
+        protection,
         rate_source,
     } = cfg;
     let Orbit {
@@ -929,6 +930,19 @@ pub fn config_digest(cfg: &crate::controller::Config<f32>) -> u32 {
             .into_iter()
             .fold(h, |h, &x| fnv1a_f32(h, x));
             h = fnv1a(h, &max_rejections.to_le_bytes());
+        }
+    }
+    // The protection, when configured (an unprotected configuration's digest is unchanged).
+    if let Some(p) = protection {
+        let crate::controller::ProtectionConfig {
+            min_tension_n,
+            max_tension_n,
+            tension_filter_s,
+            drive_lag_s,
+        } = p;
+        h = fnv1a(h, &[2]);
+        for x in [min_tension_n, max_tension_n, tension_filter_s, drive_lag_s] {
+            h = fnv1a_f32(h, *x);
         }
     }
     h

@@ -5,6 +5,8 @@
 
 use crate::real::Real;
 
+pub mod libration;
+
 /// Earth's gravitational parameter μ, m³/s² (IERS/WGS-84 value, docs/equations.md §0).
 pub const EARTH_MU_M3PS2: f64 = 3.986_004_418e14;
 
@@ -75,6 +77,72 @@ impl<T: Real> Orbit<T> {
     }
 }
 
+/// The orbit's kinematics at one true anomaly, everything an eccentric-orbit step needs
+/// (docs/equations.md §0, §16.4), from one sin_cos of θ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OrbitAt<T> {
+    /// θ̇, rad/s.
+    pub rate_radps: T,
+    /// θ̈ = θ̇² h, h = −2e sinθ/(1 + e cosθ), rad/s².
+    pub accel_radps2: T,
+    /// θ⃛ = θ̇³ (2h² + h′), h′ = −2e(cosθ + e)/(1 + e cosθ)², rad/s³.
+    pub jerk_radps3: T,
+    /// μ/R³ = θ̇²/(1 + e cosθ), 1/s².
+    pub gravity_gradient_per_s2: T,
+    /// d(μ/R³)/dt = 1.5 h θ̇ μ/R³, 1/s³.
+    pub gravity_gradient_rate_per_s3: T,
+}
+
+/// An [`Orbit`] with its constants worked out once (in f64, rounded once), for evaluation at
+/// every step: [`PreparedOrbit::at`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PreparedOrbit<T> {
+    eccentricity: T,
+    /// ω/(1 − e²)^{3/2}, rad/s: θ̇ = this · (1 + e cosθ)².
+    rate_scale_radps: T,
+}
+
+impl<T: Real> Orbit<T> {
+    /// The orbit ready for [`PreparedOrbit::at`].
+    pub fn prepare(&self) -> PreparedOrbit<T> {
+        let e = self.eccentricity.to_f64();
+        let a = self.semi_major_axis_m.to_f64();
+        let w = libm::sqrt(self.mu_m3ps2.to_f64() / (a * a * a));
+        let k = 1.0 - e * e;
+        PreparedOrbit {
+            eccentricity: self.eccentricity,
+            rate_scale_radps: T::from_f64(w / (k * libm::sqrt(k))),
+        }
+    }
+}
+
+impl<T: Real> PreparedOrbit<T> {
+    /// θ̇, θ̈, θ⃛, μ/R³ and its rate at true anomaly θ (rad).
+    pub fn at(&self, true_anomaly_rad: T) -> OrbitAt<T> {
+        let (s, c) = true_anomaly_rad.sin_cos();
+        self.at_sin_cos(s, c)
+    }
+
+    /// [`PreparedOrbit::at`] from sinθ and cosθ.
+    pub fn at_sin_cos(&self, sin_theta: T, cos_theta: T) -> OrbitAt<T> {
+        let e = self.eccentricity;
+        let two = T::from_f64(2.0);
+        let k = T::ONE + e * cos_theta;
+        let rate = self.rate_scale_radps * k * k;
+        let h = -two * e * sin_theta / k;
+        let h_slope = -two * e * (cos_theta + e) / (k * k);
+        let rate2 = rate * rate;
+        let gg = rate2 / k;
+        OrbitAt {
+            rate_radps: rate,
+            accel_radps2: rate2 * h,
+            jerk_radps3: rate2 * rate * (two * h * h + h_slope),
+            gravity_gradient_per_s2: gg,
+            gravity_gradient_rate_per_s3: T::from_f64(1.5) * h * rate * gg,
+        }
+    }
+}
+
 /// Orbit rate of a circular orbit of the given radius, n = √(μ/R³), rad/s.
 pub fn circular_rate_radps<T: Real>(radius_m: T) -> T {
     Orbit::circular(radius_m).mean_motion_radps()
@@ -123,5 +191,35 @@ mod tests {
             (o.true_anomaly_accel_radps2(th) - fd).abs() < 1e-6 * fd.abs(),
             "{fd}"
         );
+    }
+
+    #[test]
+    fn prepared_orbit_matches_the_elliptic_kinematics_and_its_derivatives() {
+        let o = Orbit::elliptic(10.0e6, 0.3);
+        let p = o.prepare();
+        for &th in &[0.0, 0.7, 2.0, 3.1, -1.2] {
+            let s = p.at(th);
+            let rel = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1e-30);
+            assert!(rel(s.rate_radps, o.true_anomaly_rate_radps(th)));
+            assert!(rel(s.accel_radps2, o.true_anomaly_accel_radps2(th)));
+            assert!(rel(
+                s.gravity_gradient_per_s2,
+                o.gravity_gradient_per_s2(th)
+            ));
+            // θ⃛ and d(μ/R³)/dt: d/dθ by central difference, times θ̇.
+            let h = 1e-5;
+            let (m, q) = (p.at(th - h), p.at(th + h));
+            let jerk = (q.accel_radps2 - m.accel_radps2) / (2.0 * h) * s.rate_radps;
+            let gg_rate =
+                (q.gravity_gradient_per_s2 - m.gravity_gradient_per_s2) / (2.0 * h) * s.rate_radps;
+            assert!(
+                (s.jerk_radps3 - jerk).abs() < 1e-8 * jerk.abs().max(1e-12),
+                "{th}"
+            );
+            assert!(
+                (s.gravity_gradient_rate_per_s3 - gg_rate).abs() < 1e-8 * gg_rate.abs().max(1e-18),
+                "{th}"
+            );
+        }
     }
 }

@@ -15,6 +15,9 @@
 //! Eq. 34 (stage 1) is `low = (10 km, −π/4, 0)`, `high = (30 km, 0, π·10⁻⁵)`;
 //! Eq. 35 (stage 2) is `low = (2 km, 0, 5π·10⁻⁵)`, `high = (5 km, π/10, 0)`.
 
+use crate::law::OrbitForcing;
+use crate::orbit::libration::{Libration, LibrationPoint};
+use crate::orbit::{Orbit, OrbitAt, PreparedOrbit};
 use crate::real::Real;
 
 /// α_r and its first two derivatives with respect to tether length.
@@ -220,12 +223,14 @@ impl<T: Real> PreparedBand<T> {
                 },
                 time_rate_radps: slew_rate_radps,
                 slewing: true,
+                orbit: None,
             }
         } else {
             Reference {
                 angle: scheduled,
                 time_rate_radps: T::ZERO,
                 slewing: false,
+                orbit: None,
             }
         }
     }
@@ -254,6 +259,10 @@ pub struct Reference<T> {
     pub time_rate_radps: T,
     /// `true` while the slew is still below the schedule.
     pub slewing: bool,
+    /// On an eccentric orbit, the orbit's terms and the reference's higher time derivatives
+    /// that the law needs ([`LibratingReference`], docs/equations.md §16); `None` on a
+    /// circular orbit.
+    pub orbit: Option<OrbitForcing<T>>,
 }
 
 impl<T: Real> SlewedSchedule<T> {
@@ -262,6 +271,154 @@ impl<T: Real> SlewedSchedule<T> {
         self.schedule
             .prepare()
             .eval_slewed(self.slew_rate_radps, tau_s, length_m)
+    }
+}
+
+/// The reference on an eccentric orbit (docs/equations.md §16.2): the schedule's α_r(l) (or the
+/// slew's α_r(t)) plus the forced periodic libration P(θ) of [`Libration`], weighted by
+/// cos 2α_r,
+///
+/// ```text
+///   α_ref(l, θ) = α_r + cos(2α_r) · P(θ)
+/// ```
+///
+/// so that it is P itself at the keeps (α_r → 0: keeping a length does not fight the orbit's
+/// forcing) and α_r itself on the −45° deployment plateau (where the reel holds α_r exactly,
+/// inside the Eq. 13 extent), and in between the rate the reference asks for keeps the sign of
+/// its stage all orbit long (to first order in e, for e ≤ 0.6: §16.2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LibratingReference<T> {
+    orbit: PreparedOrbit<T>,
+    libration: Libration<T>,
+}
+
+impl<T: Real> LibratingReference<T> {
+    /// The reference for `orbit`, or `None` on a circular one (e = 0: the paper's reference
+    /// and law, unchanged). Beyond the eccentricities [`Libration::new`] solves
+    /// ([`crate::orbit::libration::MAX_ECCENTRICITY`]) P ≡ 0: the law still takes the orbit's
+    /// θ̈ and μ/R³, and the reference is α_r.
+    pub fn new(orbit: &Orbit<T>) -> Option<Self> {
+        if orbit.eccentricity == T::ZERO {
+            return None;
+        }
+        let libration = Libration::new(orbit.eccentricity).unwrap_or(Libration::NONE);
+        Some(Self {
+            orbit: orbit.prepare(),
+            libration,
+        })
+    }
+
+    /// The periodic libration P this reference adds.
+    pub fn libration(&self) -> &Libration<T> {
+        &self.libration
+    }
+
+    /// The reference when θ is not finite: the schedule's α_r with every orbit term NaN, so
+    /// that the law cannot run on it ([`crate::law::LawFault::NotFinite`], the controller's
+    /// safe action) while α_r is still reported (docs/equations.md §16.6).
+    pub fn without_anomaly(base: Reference<T>) -> Reference<T> {
+        let nan = T::from_f64(f64::NAN);
+        Reference {
+            orbit: Some(OrbitForcing {
+                gradient_per_s2: nan,
+                gradient_rate_per_s3: nan,
+                orbit_accel_radps2: nan,
+                orbit_jerk_radps3: nan,
+                ref_time_accel_radps2: nan,
+                ref_time_jerk_radps3: nan,
+                ref_slope_rate_rad_per_m_s: nan,
+                ref_time_accel_slope_rad_per_m_s2: nan,
+            }),
+            ..base
+        }
+    }
+
+    /// The reference at true anomaly θ (rad) from the circular one `base` (α_r, ∂α_r/∂l,
+    /// ∂²α_r/∂l², ∂α_r/∂t): every partial derivative the law needs (§16.2; it assumes, as both
+    /// schedules give, that ∂α_r/∂l does not depend on t nor ∂α_r/∂t on l).
+    pub fn eval(&self, base: Reference<T>, true_anomaly_rad: T) -> Reference<T> {
+        let (sin_theta, cos_theta) = true_anomaly_rad.sin_cos();
+        let o = self.orbit.at_sin_cos(sin_theta, cos_theta);
+        let p = self.libration.eval_sin_cos(sin_theta, cos_theta);
+        compose(base, &o, &p)
+    }
+}
+
+/// α_ref = α_r + cos(2α_r) P and its partial derivatives (docs/equations.md §16.2).
+pub fn compose<T: Real>(
+    base: Reference<T>,
+    o: &OrbitAt<T>,
+    lib: &LibrationPoint<T>,
+) -> Reference<T> {
+    let f = T::from_f64;
+    let a = base.angle;
+    let (pr, qr, rs) = (
+        a.slope_rad_per_m,
+        a.curvature_rad_per_m2,
+        base.time_rate_radps,
+    );
+    let wt = Weight::at(a.angle_rad);
+    let (w, w1, w2, w3) = (wt.value, wt.first, wt.second, wt.third);
+    let (rate, rate2, accel) = (o.rate_radps, o.rate_radps * o.rate_radps, o.accel_radps2);
+    // P and its time derivatives at fixed l: θ̇ P′, θ̇² P″ + θ̈ P′, θ̇³ P‴ + 3θ̇θ̈ P″ + θ⃛ P′.
+    let p0 = lib.angle_rad;
+    let p1 = rate * lib.slope;
+    let p2 = rate2 * lib.curvature + accel * lib.slope;
+    let p3 = rate2 * rate * lib.third
+        + f(3.0) * rate * accel * lib.curvature
+        + o.jerk_radps3 * lib.slope;
+    // ∂α_ref/∂α_r = 1 + w′P.
+    let k = T::ONE + w1 * p0;
+    let rs2 = rs * rs;
+    Reference {
+        angle: RefAngle {
+            angle_rad: a.angle_rad + w * p0,
+            slope_rad_per_m: pr * k,
+            curvature_rad_per_m2: qr * k + w2 * p0 * pr * pr,
+        },
+        time_rate_radps: rs * k + w * p1,
+        slewing: base.slewing,
+        orbit: Some(OrbitForcing {
+            gradient_per_s2: f(1.5) * o.gravity_gradient_per_s2,
+            gradient_rate_per_s3: f(1.5) * o.gravity_gradient_rate_per_s3,
+            orbit_accel_radps2: o.accel_radps2,
+            orbit_jerk_radps3: o.jerk_radps3,
+            ref_time_accel_radps2: w2 * rs2 * p0 + f(2.0) * w1 * rs * p1 + w * p2,
+            ref_time_jerk_radps3: w3 * rs2 * rs * p0
+                + f(3.0) * (w2 * rs2 * p1 + w1 * rs * p2)
+                + w * p3,
+            ref_slope_rate_rad_per_m_s: pr * (w2 * rs * p0 + w1 * p1),
+            ref_time_accel_slope_rad_per_m_s2: pr
+                * (w3 * rs2 * p0 + f(2.0) * w2 * rs * p1 + w1 * p2),
+        }),
+    }
+}
+
+/// The libration's weight w(α_r) = cos 2α_r and its first three derivatives with respect to
+/// α_r (docs/equations.md §16.2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Weight<T> {
+    /// w.
+    pub value: T,
+    /// dw/dα_r, 1/rad.
+    pub first: T,
+    /// d²w/dα_r², 1/rad².
+    pub second: T,
+    /// d³w/dα_r³, 1/rad³.
+    pub third: T,
+}
+
+impl<T: Real> Weight<T> {
+    /// w = cos 2α_r at α_r (rad): 1 at the keeps, 0 on the −45° plateau.
+    pub fn at(ref_angle_rad: T) -> Self {
+        let f = T::from_f64;
+        let (s2, c2) = (f(2.0) * ref_angle_rad).sin_cos();
+        Self {
+            value: c2,
+            first: -f(2.0) * s2,
+            second: -f(4.0) * c2,
+            third: f(8.0) * s2,
+        }
     }
 }
 

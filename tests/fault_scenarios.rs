@@ -428,7 +428,14 @@ fn one_tick_length_glitch_is_rejected_without_effect() {
 /// passage of early deployment (measured: one episode, 983–1268 s at l ≈ 26 m).
 #[test]
 fn lagging_saturating_reel_counts_saturation_and_keeps_the_envelope() {
-    let h = run(REEL_LIMITS, &["reel.lag_s=2", "reel.max_accel_mps2=0.1"]);
+    let h = run(
+        REEL_LIMITS,
+        &[
+            "reel.lag_s=2",
+            "reel.max_accel_mps2=0.1",
+            "protection.drive_lag_s=2",
+        ],
+    );
     let f = &h.faults;
     // Measured: rate-saturated 333 ticks, accel-saturated 92, drive at its limit 90 periods.
     assert!(
@@ -461,22 +468,68 @@ fn lagging_saturating_reel_counts_saturation_and_keeps_the_envelope() {
     assert!(d < 0.05, "{d}");
 }
 
-/// HZ-7, open: a 2 s lag with no acceleration limit of its own. Following the controller's
-/// staircase of 0.1 m/s steps, the drive's instantaneous acceleration peaks at
-/// 0.1/(1 − e^{−1/2}) ≈ 0.25 m/s ÷ 2 s ≈ 0.127 m/s² right after each step; when the slew
-/// ends (t ≈ 29 300 s) the controller brakes the wind-in at its 0.1 m/s² limit with only
-/// 10.7 N − 99 kg × 0.1 m/s² ≈ 0.8 N of tension to spare, so the tether goes slack for 89 s
-/// (29 303–29 392 s, min −1.93 N). The envelope does not bound the physical acceleration of a lagging drive.
+/// HZ-7, O-4 (fixed): a 2 s lag with no acceleration limit of its own. Following the
+/// controller's staircase of 0.1 m/s steps, the drive's instantaneous acceleration peaks at
+/// 0.1/(1 − e^{−1/2}) ≈ 0.25 m/s ÷ 2 s ≈ 0.127 m/s² right after each step; when the slew ends
+/// (t ≈ 29 300 s) the controller braked the wind-in at its 0.1 m/s² limit with only
+/// 10.7 N − 99 kg × 0.1 m/s² ≈ 0.8 N of tension to spare, so the tether went slack for 89 s
+/// (29 303–29 392 s, min −1.93 N; 1 s lag: −5.0 N). The protection, told the drive's lag, bounds
+/// the drive's peak acceleration l̈_now + Δu/τ by the measured tension: no slack at any time
+/// (measured: min 2.0 mN from the first tension sample on, for 2 s and 1 s).
 #[test]
-#[ignore = "open hazard (core): a lagging reel without its own acceleration limit slackens the tether at the stage-2 braking (min -1.93 N, 2 episodes, 374 s)"]
 fn lagging_reel_without_drive_limit_stays_taut_after_early_deployment() {
+    for lag in ["2", "1"] {
+        let h = run(
+            REEL_LIMITS,
+            &[
+                &format!("reel.lag_s={lag}"),
+                &format!("protection.drive_lag_s={lag}"),
+                "simulation.output_interval_s=1",
+            ],
+        );
+        let f = &h.faults;
+        assert_eq!(f.slack_events, 0, "lag {lag} s: {:?}", f.slack_episodes);
+        let stage2 = min_tension_from(&h, 28_800.0);
+        eprintln!("lag {lag} s: min tension in stage 2 {stage2:?}");
+        assert!(stage2.0 > 1.9e-3, "{stage2:?}");
+        let released = margin_ratio_from(&h, 1.0);
+        assert!(released.0 > 1.0 - 1e-3, "{released:?}");
+        assert_envelope(f, 0.0);
+    }
+    // The protection must know the drive: flown as if it followed its command (τ = 0), the
+    // same drive still slackens the tether at the stage-2 braking.
     let h = run(REEL_LIMITS, &["reel.lag_s=2"]);
-    let f = &h.faults;
-    assert!(
-        f.slack_episodes.iter().all(|e| e.1 <= 1_800.0),
-        "{:?}",
-        f.slack_episodes
-    );
+    assert!(h.faults.slack_events > 0);
+}
+
+/// The least tension the protection keeps at length `l` (paper-reel-limits.toml's 2 mN, less
+/// on a short tether: a quarter of the vertical tether's gravity-gradient tension, 3 m_r n² l,
+/// `MARGIN_OF_GRAVITY_GRADIENT`), N.
+fn tension_margin_n(length_m: f64) -> f64 {
+    let n2 = tss_reel::orbit::EARTH_MU_M3PS2 / 7_078_000f64.powi(3);
+    let m_r = 10_000.0 * 100.0 / 10_100.0;
+    let share = tss_reel::controller::MARGIN_OF_GRAVITY_GRADIENT;
+    (share * 3.0 * m_r * n2 * length_m).min(2e-3)
+}
+
+/// The smallest ratio of the true tension to the protection's margin at that length, from
+/// `t0_s` on, and when.
+fn margin_ratio_from(h: &History, t0_s: f64) -> (f64, f64) {
+    h.samples
+        .iter()
+        .filter(|s| s.t_s >= t0_s)
+        .map(|s| (s.tension_n / tension_margin_n(s.length_m), s.t_s))
+        .fold((f64::INFINITY, 0.0), |m, x| if x.0 < m.0 { x } else { m })
+}
+
+/// The smallest true tension (at the start of each recorded period, N) from `t0_s` on, and
+/// when.
+fn min_tension_from(h: &History, t0_s: f64) -> (f64, f64) {
+    h.samples
+        .iter()
+        .filter(|s| s.t_s >= t0_s)
+        .map(|s| (s.tension_n, s.t_s))
+        .fold((f64::INFINITY, 0.0), |m, x| if x.0 < m.0 { x } else { m })
 }
 
 /// Flies `file` with `overrides` on the controller configured to fly `RateSource::Estimator`
@@ -592,14 +645,37 @@ fn dropout_approaching_the_spool_end_holds_the_limit_on_the_predicted_length() {
     assert_envelope(f, 0.0);
 }
 
-/// HZ-8, open: the spool-end limit and its braking curve act on the command, so a drive that
-/// lags runs past them. Realistic reel, 2 s lag, drive limited to 0.1 m/s², spool end 30 500 m,
-/// no fault at all: the tether passes the spool end by 7.2 m (1.1 m with an unlimited drive)
-/// and stays beyond it for 929 s; in the last periods the length limit also overrides the
-/// acceleration limit (26 commands beyond 0.1 m/s², up to 0.35 m/s²).
+/// HZ-8, O-2 (fixed): the spool-end limit and its braking curve acted on the command, so a drive
+/// that lags ran past them: realistic reel, 2 s lag, drive limited to 0.1 m/s², spool end
+/// 30 500 m, no fault at all: the tether passed the spool end by 7.2 m (1.1 m with an unlimited
+/// drive) and stayed beyond it for 929 s, and the length limit overrode the acceleration limit
+/// in the last periods (26 commands beyond 0.1 m/s², up to 0.35 m/s²). With the protection
+/// told the drive's lag (`protection.drive_lag_s = 2`), the room to the limit is measured less
+/// the drive's overrun τ|v| and the staircase brakes at a·(1 − e^{−h})/h, so the drive's peak
+/// acceleration is the limit: measured, the tether stops at 30 499.997 m, no command beyond
+/// 0.08 m/s² (with and without the drive's own limit).
 #[test]
-#[ignore = "open hazard (core): the spool-end braking curve ignores the drive's lag; a 2 s lag overshoots the limit by 7.2 m"]
 fn spool_end_holds_with_a_lagging_drive() {
+    for drive in [&["reel.max_accel_mps2=0.1"][..], &[]] {
+        let mut sets = vec![
+            "envelope.max_length_m=30500",
+            "simulation.duration_s=14400",
+            "reel.lag_s=2",
+            "protection.enabled=true",
+            "protection.drive_lag_s=2",
+        ];
+        sets.extend_from_slice(drive);
+        let h = run(REEL_LIMITS, &sets);
+        let f = &h.faults;
+        assert!(f.max_excursion_m <= 0.0, "{} m beyond", f.max_excursion_m);
+        assert!(
+            f.length_range_m.1 > 30_499.9,
+            "stopped at {}",
+            f.length_range_m.1
+        );
+        assert_envelope(f, 0.0);
+    }
+    // Without the protection the same drive passes the spool end (the hazard as it was).
     let h = run(
         REEL_LIMITS,
         &[
@@ -610,8 +686,8 @@ fn spool_end_holds_with_a_lagging_drive() {
         ],
     );
     assert!(
-        h.faults.max_excursion_m <= 1e-3,
-        "{} m beyond",
+        h.faults.max_excursion_m > 5.0,
+        "{}",
         h.faults.max_excursion_m
     );
 }
@@ -642,6 +718,147 @@ fn early_safe_hold_slackens_the_short_tether_but_deployment_resumes() {
         .expect("keep reached");
     assert!(keep.t_s < 13_000.0, "keep at {} s", keep.t_s);
     assert_envelope(f, 0.0);
+}
+
+/// O-6 (closed by the protection): the paper's deployment has no tension margin (3.3e-5 N at
+/// l ≈ 26 m, t ≈ 1051 s: the tether swings back to α ≈ −70°, where Eq. 5a's free tension
+/// vanishes). With the protection (scenarios/paper-reel-limits.toml: T_min = 2 mN, on the
+/// true tension at the reel) the tether keeps its margin from the first tension sample on
+/// (T_min, or a quarter of 3 m_r n² l on a short tether: measured min 2.000 mN at 2 327 s): the
+/// pay-out brakes, then winds in 1.1 m while the swing passes (the bound acts on l̈, not on
+/// the direction), and resumes. The cost, measured on the paper's envelope: the 30 km keep is
+/// reached 230 s *earlier* (11 580 s against 11 810 s: the braking damps the swing), Table-1
+/// lengths at 2 h / 4 h / 6 h of 2 461.9 / 29 661.4 / 29 999.19 m against 2 048.0 / 29 601.9 /
+/// 29 999.51 m, 8 h within 3 mm of 30 km either way, the Table-1 instants (7–8 h) within
+/// 3.1 cm of the unprotected run. Table 1 itself (paper.toml, no protection) is unchanged.
+/// The bound starts once, in one stretch (680–2 397 s): no chatter.
+#[test]
+fn the_protection_keeps_the_tension_margin_from_release() {
+    let h = run(
+        REEL_LIMITS,
+        &[
+            "simulation.duration_s=28800",
+            "simulation.output_interval_s=1",
+        ],
+    );
+    let f = &h.faults;
+    let released = margin_ratio_from(&h, 1.0);
+    eprintln!(
+        "protected: min tension {:?}, least share of the margin {released:?}",
+        f.min_tension_n
+    );
+    assert!(released.0 >= 1.0 - 1e-3, "{released:?}");
+    assert_eq!(f.slack_events, 0);
+    assert_envelope(f, 0.0);
+    let starts = h
+        .samples
+        .windows(2)
+        .filter(|w| {
+            w[1].flags & Flags::TENSION_LIMITED != 0 && w[0].flags & Flags::TENSION_LIMITED == 0
+        })
+        .count();
+    assert_eq!(starts, 1, "the tension bound starts once");
+
+    // What the margin costs, on the paper's own envelope (no reel limits).
+    let keep1 = |h: &History| {
+        h.samples
+            .iter()
+            .find(|s| s.phase == PhaseLabel::Keep1)
+            .map(|s| s.t_s)
+            .expect("keep reached")
+    };
+    let protected = run(
+        PAPER,
+        &["simulation.duration_s=28800", "protection.enabled=true"],
+    );
+    let (a, b) = (keep1(&protected), keep1(clean_stage1()));
+    eprintln!("margin cost: keep at {a} s (unprotected {b} s)");
+    for t in [7200.0, 14_400.0, 21_600.0, 28_800.0] {
+        let (p, q) = (at(&protected, t).length_m, at(clean_stage1(), t).length_m);
+        eprintln!("  t = {t} s: {p:.3} m (unprotected {q:.3} m)");
+    }
+    let d = probe_difference(&protected, clean_stage1());
+    eprintln!("  Table 1 (7–8 h): largest difference {d:.4} m");
+    assert!(d < 0.1, "{d}"); // measured 3.1 cm (the keep settles from a different approach)
+    assert!(a <= b, "{a} vs {b}");
+    assert!(protected.faults.min_tension_n.0 >= 2e-3 * (1.0 - 1e-3));
+    let at_8h = protected.probes.iter().find(|p| p.0 == 28_800.0).unwrap();
+    assert!((at_8h.1 - 30_000.0).abs() < 0.01, "{at_8h:?}");
+}
+
+/// O-6: the disturbances that slackened the unprotected start no longer do. A 1° α bias
+/// (was slack 866–1284 s; the biased model is corrected by the load cell over τ_f, measured
+/// min 1.77 mN, 88 % of the margin) and a 2 s reel lag (was slack 983–1268 s; measured min 2.0 mN from the first
+/// tension sample on).
+#[test]
+fn the_protected_start_does_not_slacken_under_bias_or_lag() {
+    let bias = format!("sensors.alpha.bias={}", 1f64.to_radians());
+    let h = run(
+        PAPER,
+        &[
+            &bias,
+            "protection.enabled=true",
+            "simulation.duration_s=14400",
+            "simulation.output_interval_s=1",
+        ],
+    );
+    let share = margin_ratio_from(&h, 1.0);
+    eprintln!(
+        "bias: min tension {:?}, least share of the margin {share:?}",
+        h.faults.min_tension_n
+    );
+    assert_eq!(h.faults.slack_events, 0, "{:?}", h.faults.slack_episodes);
+    assert!(share.0 > 0.8, "{share:?}");
+    let h = run(
+        REEL_LIMITS,
+        &[
+            "reel.lag_s=2",
+            "reel.max_accel_mps2=0.1",
+            "protection.drive_lag_s=2",
+            "simulation.duration_s=14400",
+            "simulation.output_interval_s=1",
+        ],
+    );
+    let released = margin_ratio_from(&h, 1.0);
+    eprintln!("lag: least share of the margin from release {released:?}");
+    assert_eq!(h.faults.slack_events, 0, "{:?}", h.faults.slack_episodes);
+    assert!(released.0 > 1.0 - 1e-3, "{released:?}");
+}
+
+/// The safe hold ramps at a rate the tether carries: the early safe hold (l ≈ 5 m) that
+/// slackened the short tether for 8 minutes (above) keeps it taut when the tension bound
+/// applies to the hold and to the restarted blend: at l ≈ 5–10 m the margin is a quarter of
+/// 3 m_r n² l (0.4–0.8 mN), the free tension the tether has there; a fixed 2 mN wound the
+/// tether in for 1 600 s against the law until it swung through the vertical (a law fault and
+/// a second safe hold). Measured: min 0.46 mN at 858 s, at least 99 % of the margin after
+/// the dropout, the keep reached at 12 430 s (unprotected: 12 min late as well).
+#[test]
+fn the_protected_early_safe_hold_keeps_the_short_tether_taut() {
+    let h = run(
+        PAPER,
+        &[
+            "simulation.duration_s=14400",
+            "simulation.output_interval_s=1",
+            "protection.enabled=true",
+            "faults.dropout=[{ from_s = 40, until_s = 80 }]",
+        ],
+    );
+    let f = &h.faults;
+    assert!(f.safe_hold_s > 0.0);
+    assert_eq!(f.slack_events, 0, "{:?}", f.slack_episodes);
+    assert_eq!(f.safe_hold_s, 19.0, "one safe hold");
+    let after = margin_ratio_from(&h, 80.0);
+    eprintln!(
+        "early hold: min tension {:?}, least share of the margin after the dropout {after:?}",
+        f.min_tension_n
+    );
+    assert!(after.0 >= 0.99, "{after:?}");
+    let keep = h
+        .samples
+        .iter()
+        .find(|s| s.phase == PhaseLabel::Keep1)
+        .expect("keep reached");
+    assert!(keep.t_s < 13_000.0, "keep at {} s", keep.t_s);
 }
 
 /// HZ-8, core: approaching the spool end under the realistic envelope (0.1 m/s²). The

@@ -187,6 +187,7 @@ mod tests {
             alpha_rad: -0.6,
             alpha_rate_radps: 1.0e-4,
             orbit_rate_radps: 1.060_237_2e-3,
+            orbit: None,
             ref_angle_rad: -0.55,
             ref_slope_rad_per_m: 6.0e-5,
             ref_curvature_rad_per_m2: 3.0e-9,

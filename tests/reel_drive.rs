@@ -11,6 +11,10 @@
 
 use proptest::prelude::*;
 use std::f64::consts::TAU;
+
+/// The drive's faults in the outer controller's health (`Controller::step_with_drive`).
+#[path = "reel_drive/health.rs"]
+mod health;
 use tss_reel::reel_drive::{
     Brake, DriveConfig, DriveFault, DriveInput, DriveOutput, DriveRule, RateCommand, SpeedLoop,
 };
@@ -404,7 +408,7 @@ fn a_counter_that_lost_counts_for_good_trips_the_drive() {
             assert!(!out.brake.brake_released() && !out.brake.motor_enabled());
             assert_eq!(
                 out.faults.outer_reaction(),
-                tss_reel::reel_drive::OuterReaction::LengthSampleMissing
+                tss_reel::reel_drive::OuterReaction::Degrade
             );
         }
     }
@@ -623,7 +627,7 @@ fn every_invalid_parameter_is_named() {
             c.geometry.encoder_bits = 33
         }),
         ("speed_window_ticks", DriveRule::OutOfRange, |c| {
-            c.speed_window_ticks = 9
+            c.speed_window_ticks = 6
         }),
         ("drum.coulomb_nm", DriveRule::Negative, |c| {
             c.drum.coulomb_nm = -0.1
@@ -737,10 +741,11 @@ proptest! {
                         tension_n,
                     });
                     prop_assert!(out.duty.is_finite() && out.duty.abs() <= cfg.duty_limit, "{:?}", out);
+                    let p = drive.torque_parts();
                     for v in [
-                        out.ref_rate_mps, out.ref_accel_mps2, out.speed_mps, out.error_mps,
-                        out.p_nm, out.i_nm, out.ff_inertia_nm, out.ff_tension_nm,
-                        out.ff_friction_nm, out.tension_n, out.torque_nm,
+                        out.ref_rate_mps, out.ref_accel_mps2, out.speed_mps, p.error_mps,
+                        p.p_nm, p.i_nm, p.ff_inertia_nm, p.ff_tension_nm,
+                        p.ff_friction_nm, out.tension_n, out.torque_nm,
                     ] {
                         prop_assert!(v.is_finite(), "{:?}", out);
                     }

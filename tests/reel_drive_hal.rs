@@ -338,3 +338,61 @@ fn failed_reads_are_missing_samples_and_keep_the_brake_engaged() {
     drop(drive);
     m.done();
 }
+
+/// The QEMU firmware's inner loop on the host: the drive over the simulated reel
+/// (`reel_drive::sim`, its drum 10 % / 20 % / 25 % off the drive's model) follows the law's
+/// ramps (each reaches its command within the law period) through the brake release, a
+/// reversal and a stop, within 1 cm/s of its reference after the release's first 100 ms.
+#[test]
+fn the_drive_over_the_simulated_reel_tracks_ramps_and_stops() {
+    use std::cell::RefCell;
+    use tss_reel::reel_drive::sim::{PinRole, SimDrum, SimEncoder, SimLoadCell, SimPin, SimPwm};
+
+    let cfg = DriveConfig::example();
+    let drum = RefCell::new(SimDrum::mismatched(&cfg, 20.0));
+    let pins = MotorPins {
+        pwm: SimPwm(&drum),
+        direction: SimPin(&drum, PinRole::Direction),
+        brake: SimPin(&drum, PinRole::Brake),
+        enable: SimPin(&drum, PinRole::Enable),
+    };
+    let speed = SpeedLoop::new(cfg).unwrap();
+    let mut drive = HalReelDrive::new(speed, SimEncoder(&drum), SimLoadCell(&drum), pins).unwrap();
+    // Commands once a second: up to 2 m/s, hold, down to −1 m/s, stop.
+    let commands = [0.5, 1.0, 2.0, 2.0, 1.0, -1.0, -1.0, 0.0, 0.0, 0.0];
+    let mut worst_mps = 0.0_f32;
+    let mut released_ticks = 0;
+    for (period, &rate) in commands.iter().enumerate() {
+        let start = period as u32 * 1000;
+        let cmd = RateCommand {
+            rate_mps: rate,
+            accel_mps2: 0.0,
+            safe_hold: false,
+        };
+        drive.set_command(cmd, start).unwrap();
+        for tick in start..start + 1000 {
+            let cycle = drive.tick(tick);
+            assert_eq!(cycle, Default::default(), "{tick}");
+            drum.borrow_mut().advance(1e-3);
+            let out = *drive.output();
+            assert!(out.faults.is_empty(), "{tick}: {out:?}");
+            if matches!(out.brake, Brake::Released { .. }) {
+                released_ticks += 1;
+                if released_ticks > 100 {
+                    let error = (drum.borrow().speed_mps() - out.ref_rate_mps).abs();
+                    worst_mps = worst_mps.max(error);
+                }
+            }
+        }
+        if (1..=6).contains(&period) {
+            assert!((drum.borrow().speed_mps() - rate).abs() < 0.01, "{period}");
+        }
+    }
+    assert!(worst_mps < 0.01, "{worst_mps}");
+    // Stopped and braked at the end; the counted length is the drum's, to a count.
+    assert_eq!(drive.output().brake, Brake::Engaged);
+    assert_eq!(drum.borrow().speed_mps(), 0.0);
+    let m_per_count = cfg.geometry.m_per_count();
+    let counted = drive.speed_loop().paid_out_m();
+    assert!((counted - drum.borrow().paid_out_m()).abs() <= 2.0 * m_per_count);
+}

@@ -3,6 +3,7 @@
 
 pub mod analysis;
 pub mod compare;
+pub mod eccentric;
 pub mod elastic;
 pub mod faults;
 pub mod history;

@@ -6,7 +6,7 @@
 use std::process::ExitCode;
 
 use clap::{CommandFactory, Parser, Subcommand};
-use tss_sim::{analysis, compare, montecarlo, run_cmd, scenario, usage};
+use tss_sim::{analysis, compare, eccentric, montecarlo, run_cmd, scenario, usage};
 
 /// Exit code for usage errors (as clap uses for bad arguments).
 const EXIT_USAGE: u8 = 2;
@@ -40,6 +40,8 @@ enum Command {
     /// Monte Carlo campaign: fly the scenario N times with its `[montecarlo]` dispersions (in
     /// parallel, reproducible from the seed), write runs.csv, summary.txt and figures.
     Montecarlo(montecarlo::MonteCarloArgs),
+    /// Fly the scenario at each eccentricity; write the keep errors (table, CSV, figure).
+    Eccentric(eccentric::EccentricArgs),
     /// Fly several deployment laws (`[controller] law`) on one scenario, and with --runs on the
     /// same dispersed campaign; write one table (compare.txt, compare.csv) and overlaid figures.
     Compare(compare::CompareArgs),
@@ -98,6 +100,7 @@ fn main() -> ExitCode {
         Command::Stability(args) => analysis::run_stability(&args),
         Command::Montecarlo(args) => montecarlo::montecarlo(&args),
         Command::Merge(args) => montecarlo::merge(&args),
+        Command::Eccentric(args) => eccentric::run_eccentric(&args),
         Command::Compare(args) => compare::compare(&args),
         Command::Completions { shell } => {
             clap_complete::generate(

@@ -38,6 +38,9 @@ pub enum EventKind {
     /// that left the physical range, or a gap in the calls longer than
     /// [`super::MAX_CARRIED_PERIODS`]): the next α starts afresh.
     EstimateLost,
+    /// The protection's tension bound began to restrict the command
+    /// ([`super::Flags::TENSION_LIMITED`], set at this step and not at the one before).
+    TensionLimited,
 }
 
 /// An event and the tick it happened at.

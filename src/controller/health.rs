@@ -65,6 +65,13 @@ impl HealthMachine {
         self.set(next, flags);
     }
 
+    /// The reel drive tripped (`drive`): safe hold at once, and the run of valid samples that
+    /// leaves it starts again.
+    pub(super) fn force_safe_hold(&mut self) {
+        self.health = Health::SafeHold;
+        self.good_ticks = 0;
+    }
+
     /// A valid sample in safe hold: `true` once `recovery_ticks` have arrived in a row, which
     /// clears the leaky counter and the run (the law may run again; [`HealthMachine::usable`]
     /// then makes the health Nominal).

@@ -57,10 +57,12 @@
 //!   sensed α̇) give way to the gate.
 
 mod clock;
+mod drive;
 mod estimation;
 mod events;
 mod health;
 mod output;
+pub(crate) mod protection;
 mod sequencer;
 
 use crate::envelope::PreparedEnvelope;
@@ -77,11 +79,13 @@ pub use crate::envelope::Envelope;
 pub use crate::monitor::{Input, Sensor};
 pub use events::{Event, EventKind, EVENT_CAPACITY};
 pub use output::{Fault, Flags, Health, Output, Phase};
+pub use protection::{ProtectionConfig, MARGIN_OF_GRAVITY_GRADIENT, MAX_PLAUSIBLE_TENSION_N};
 
 use clock::{Clock, Elapsed};
 use estimation::{Commanded, Estimated, Estimation};
 use events::EventRing;
 use health::{DeadReckoning, HealthMachine};
+use protection::{Bounds, FreeTensionModel, Protection};
 use sequencer::{Progress, Sequencer};
 
 pub use estimation::{MAX_ALPHA_VARIANCE_IN_SAMPLES, MAX_CARRIED_PERIODS};
@@ -96,6 +100,8 @@ pub struct Controller<T: Real> {
     cfg: Config<T>,
     /// The envelope, its guarded length limits worked out.
     envelope: PreparedEnvelope<T>,
+    /// The tension- and drive-aware protection (None: not configured).
+    protection: Option<Protection<T>>,
     existence: ExistenceMonitor<T>,
     monitor: Monitor<T>,
     /// The estimator the law flies on (`None`: it flies on the sensed α̇).
@@ -143,6 +149,16 @@ impl<T: Real> Controller<T> {
         };
         Ok(Self {
             envelope: PreparedEnvelope::new(cfg.envelope),
+            protection: cfg.protection.map(|p| {
+                let env = &cfg.envelope;
+                Protection::new(
+                    p,
+                    cfg.masses,
+                    cfg.period_s,
+                    env.max_rate_mps,
+                    cfg.initial_rate_mps,
+                )
+            }),
             existence,
             monitor: Monitor::new(spool_m, estimation.is_none())?,
             estimation,
@@ -241,8 +257,9 @@ impl<T: Real> Controller<T> {
     /// A step, then its events and the kept output.
     fn run(&mut self, tick: u32, sample: Option<&Input<T>>) -> Output<T> {
         let (health, phase) = (self.health.health(), self.sequencer.phase());
+        let tension_limited = self.out.flags.contains(Flags::TENSION_LIMITED);
         self.decide(tick, sample);
-        self.record_events(health, phase);
+        self.record_events(health, phase, tension_limited);
         self.out
     }
 
@@ -266,6 +283,15 @@ impl<T: Real> Controller<T> {
             Err(s) => return self.reject_stale(tick, Fault::Sensor(s), flags),
         };
         let elapsed_s = T::from_u32(elapsed_ticks) * dt;
+        if let Some(p) = &mut self.protection {
+            p.advance(
+                self.last_rate_cmd_mps,
+                self.out.accel_cmd_mps2,
+                elapsed_ticks,
+                sample.and_then(|x| x.reel_rate_mps),
+                sample.and_then(|x| x.tension_n),
+            );
+        }
         // Dead reckoning: the reel ran at the last command since the last step.
         let predicted_m = self.length.predict(self.last_rate_cmd_mps, elapsed_s);
 
@@ -306,7 +332,9 @@ impl<T: Real> Controller<T> {
         };
         self.length.sensed(x.length_m);
 
-        let reference = self.sequencer.reference(tick, x.length_m);
+        let reference = self
+            .sequencer
+            .reference_at(tick, x.length_m, x.true_anomaly_rad);
         if self.health.health() == Health::SafeHold {
             if !self.health.recovered(&self.cfg.monitor) {
                 return self.hold(tick, Some(tick), reference.angle.angle_rad, None, flags);
@@ -323,6 +351,7 @@ impl<T: Real> Controller<T> {
             alpha_rad,
             alpha_rate_radps,
             orbit_rate_radps: x.orbit_rate_radps,
+            orbit: reference.orbit,
             ref_angle_rad: reference.angle.angle_rad,
             ref_slope_rad_per_m: reference.angle.slope_rad_per_m,
             ref_curvature_rad_per_m2: reference.angle.curvature_rad_per_m2,
@@ -350,24 +379,18 @@ impl<T: Real> Controller<T> {
         // The envelope. The acceleration limit holds per command: a command differs from the
         // previous one by at most a·Δt, whatever the calls' pattern (a gap of n ticks does
         // not allow n·a·Δt: the reel ran at the previous command all along, and would step).
+        // The protection bounds it further by the tension the tether carries (and the drive).
         let previous = self.last_rate_cmd_mps;
-        let (rate, sat) = self
-            .envelope
-            .limit_request(law.rate_mps, previous, x.length_m, dt);
+        let bounds = self.bounds(Some(&FreeTensionModel::of(&law_in, &law)), previous);
+        let (rate, sat) =
+            self.envelope
+                .limit_request(law.rate_mps, previous, x.length_m, dt, &bounds);
         flags.set(sat.0);
         flags.set_if(reference.slewing, Flags::SLEWING);
-        // A limited command's acceleration is its change over the period. Otherwise Eq. 30's,
-        // bounded like every commanded quantity: Eq. 30 is the law's derivative, which leaves
-        // the envelope where the law's rate jumps (a blend restart from a held rate).
-        let max_accel = self.cfg.envelope.max_accel_mps2;
-        let accel = if sat.any() {
-            (rate - previous) / dt
-        } else if accel_mps2.abs() > max_accel {
-            flags.set(Flags::ACCEL_SATURATED);
-            accel_mps2.clamp_finite(-max_accel, max_accel)
-        } else {
-            accel_mps2
-        };
+        let (accel, accel_sat) = self
+            .envelope
+            .commanded_accel(accel_mps2, rate, previous, dt, sat, &bounds);
+        flags.set(accel_sat.0);
         self.last_rate_cmd_mps = rate;
         match self
             .sequencer
@@ -520,8 +543,11 @@ impl<T: Real> Controller<T> {
             }
         };
         let length_m = self.length.length_m().unwrap_or(T::ZERO);
-        let (rate, sat) = self.envelope.limit_request(target, previous, length_m, dt);
-        flags.set(sat.0 & Flags::LENGTH_LIMITED);
+        let bounds = self.bounds(None, previous);
+        let (rate, sat) = self
+            .envelope
+            .limit_request(target, previous, length_m, dt, &bounds);
+        flags.set(sat.0 & (Flags::LENGTH_LIMITED | Flags::TENSION_LIMITED));
         self.last_rate_cmd_mps = rate;
         let mu3 = self.cfg.masses.mu3_and_slope(length_m).0;
         let x_rate = self.existence.normalised_rate(mu3, length_m, rate);
@@ -549,6 +575,16 @@ impl<T: Real> Controller<T> {
         self.commanded(length_m, accel_mps2, mu3);
     }
 
+    /// The protection's bounds of this step (none without a protection), `model` the law's
+    /// state when it ran.
+    fn bounds(&mut self, model: Option<&FreeTensionModel<T>>, previous_mps: T) -> Bounds<T> {
+        let dt = self.cfg.period_s;
+        match &mut self.protection {
+            Some(p) => p.bounds(model, previous_mps, dt),
+            None => Bounds::none(),
+        }
+    }
+
     /// The Eq. 13 whole-orbit margin of a command whose normalised rate (Eq. 7) is `x`:
     /// min Depl − |x| (> 0 inside the region). Near docking x grows as 1/l, so the margin is
     /// reported no lower than −[`MAX_REPORTED_MARGIN`] (it is never above min Depl); a zero
@@ -570,7 +606,7 @@ impl<T: Real> Controller<T> {
     // before it still in registers): 8 instructions less on the mission's worst step
     // (scripts/bench-target: 558 → 550).
     #[inline(always)]
-    fn record_events(&mut self, health: Health, phase: Phase) {
+    fn record_events(&mut self, health: Health, phase: Phase, tension_limited: bool) {
         let out = &self.out;
         let tick = out.tick;
         if out.health != health {
@@ -593,6 +629,10 @@ impl<T: Real> Controller<T> {
         self.last_fault = out.fault;
         if out.flags.contains(Flags::BLEND_RESTART) {
             let kind = EventKind::BlendRestart;
+            self.events.push(Event { tick, kind });
+        }
+        if out.flags.contains(Flags::TENSION_LIMITED) && !tension_limited {
+            let kind = EventKind::TensionLimited;
             self.events.push(Event { tick, kind });
         }
     }

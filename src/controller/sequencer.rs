@@ -20,7 +20,7 @@
 use crate::config::Config;
 use crate::law::Blend;
 use crate::real::Real;
-use crate::schedule::{PreparedBand, Reference};
+use crate::schedule::{LibratingReference, PreparedBand, Reference};
 
 use super::output::{Flags, Phase};
 
@@ -92,6 +92,8 @@ pub(super) struct Sequencer<T> {
     stage1_band: PreparedBand<T>,
     /// The Eq. 35 schedule of stage 2, prepared.
     stage2_band: PreparedBand<T>,
+    /// On an eccentric orbit, the forced libration the reference adds (docs/equations.md §16).
+    librating: Option<LibratingReference<T>>,
     /// c of the stage-1 and stage-2 blends, 1/s.
     decay_rate_per_s: [T; 2],
     /// −cΔt·log₂e of the stage-1 and stage-2 blends.
@@ -144,6 +146,7 @@ impl<T: Real> Sequencer<T> {
             },
             stage1_band: cfg.stage1.schedule.prepare(),
             stage2_band: cfg.stage2.schedule.prepare(),
+            librating: LibratingReference::new(&cfg.orbit),
             decay_rate_per_s,
             log2_weight_per_tick,
             keep1_entry_m: cfg.stage1.schedule.high_length_m - cfg.keep_capture_m,
@@ -255,6 +258,20 @@ impl<T: Real> Sequencer<T> {
             angle: band.eval(length_m),
             time_rate_radps: T::ZERO,
             slewing: false,
+            orbit: None,
+        }
+    }
+
+    /// [`Sequencer::reference`] at true anomaly θ (rad): on an eccentric orbit, with the forced
+    /// libration and the orbit's terms (docs/equations.md §16), and with NaN orbit terms when θ
+    /// is not finite (the law then faults: the safe action); on a circular one, the same.
+    #[inline(always)]
+    pub(super) fn reference_at(&self, tick: u32, length_m: T, true_anomaly_rad: T) -> Reference<T> {
+        let base = self.reference(tick, length_m);
+        match &self.librating {
+            None => base,
+            Some(r) if true_anomaly_rad.is_finite() => r.eval(base, true_anomaly_rad),
+            Some(_) => LibratingReference::without_anomaly(base),
         }
     }
 

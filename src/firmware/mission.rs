@@ -6,15 +6,18 @@
 //! 400..450 (longer than the controller's 30-tick coast, so it goes Degraded → SafeHold and
 //! recovers). The replay ([`tss_reel::recordings::sensors::Replay`], shared with the
 //! NUCLEO-G474RE firmware) implements the [`tss_reel::hal`] sensor traits; the reel drive is a
-//! telemetry sink that folds every command into a digest. The controller is the flight one:
-//! `tss_reel::controller::Controller<f32>` with the flight configuration
-//! (`Config::flight`: the paper's mission on the onboard estimator, from the recorded α alone
-//! and the encoder's rate), stepped once per SysTick through [`tss_reel::hal::control_cycle`].
+//! telemetry sink that folds every command into a digest; the main loop hands each command
+//! ([`Mission::output`]) to the inner loop ([`super::reel`]), which makes a simulated drum
+//! follow it. The controller is the flight one: `tss_reel::controller::Controller<f32>` with
+//! the flight configuration (`Config::flight`: the paper's mission on the onboard estimator,
+//! from the recorded α alone and the encoder's rate), stepped once per law period through
+//! [`tss_reel::hal::control_cycle`].
 //!
 //! The contract with the main loop in `main.rs`:
-//! - [`CONTROL_PERIOD_MS`]: the control period; one SysTick interrupt per period;
-//! - [`MAX_TICKS`]: a hard bound on the run (a mission still running then is a failure);
-//! - [`Mission::new`] once, then [`Mission::step`] once per tick with the tick index
+//! - [`CONTROL_PERIOD_MS`]: the law's period (the inner loop's ticks divide it);
+//! - [`MAX_TICKS`]: a hard bound on the run in law periods (a mission still running then is a
+//!   failure);
+//! - [`Mission::new`] once, then [`Mission::step`] once per law period with the period index
 //!   `0, 1, 2, …`, returning [`Flow::Continue`], [`Flow::Finished`] or [`Flow::Failed`].
 //!
 //! What is logged at `info`/`warn` is checked against `expected/firmware.log` by
@@ -110,6 +113,11 @@ impl Mission {
                 tension: Replay,
             },
         }
+    }
+
+    /// The controller's last output (its command for the current law period).
+    pub fn output(&self) -> &Output<f32> {
+        self.controller.output()
     }
 
     /// One control cycle: read the replay's sensors, step the controller

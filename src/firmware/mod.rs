@@ -9,6 +9,8 @@
 //! - [`mission`]: what is done on each tick with the built-in replay
 //!   ([`crate::recordings::replay`]): **the part to replace** with the real sensors and drive;
 //!   the main loop does not change when it is;
+//! - [`reel`](mod@reel): the inner loop, the speed loop driving a simulated reel at 1 kHz under
+//!   the mission's law periods;
 //! - [`pil`]: the processor-in-the-loop mission over UART0 ([`uart`]), selected by `pil` on the
 //!   semihosting command line ([`cmdline`]; QEMU `-append pil`);
 //! - [`stack`]: the stack high-water mark (the stack is painted by cortex-m-rt at reset);
@@ -29,5 +31,6 @@ pub mod cmdline;
 pub mod exit;
 pub mod mission;
 pub mod pil;
+pub mod reel;
 pub mod stack;
 pub mod uart;

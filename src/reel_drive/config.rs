@@ -7,7 +7,7 @@
 
 use core::f32::consts::PI;
 
-/// The most speed-window samples [`DriveConfig::speed_window_ticks`] may ask for.
+/// The longest speed window [`DriveConfig::speed_window_ticks`] may ask for, ticks.
 pub const SPEED_WINDOW_CAPACITY: usize = 8;
 
 /// The slowest inner loop allowed, Hz (issue 19: "at least 100 Hz").
@@ -113,7 +113,7 @@ pub struct DriveConfig {
     pub outer_period_ticks: u32,
     /// Encoder and drum geometry.
     pub geometry: Geometry,
-    /// Accepted encoder samples the speed is differenced over (1 ..= [`SPEED_WINDOW_CAPACITY`]).
+    /// Ticks the speed is differenced over: a power of two up to [`SPEED_WINDOW_CAPACITY`].
     pub speed_window_ticks: u32,
     /// The drum's inertia and friction, for the feed-forward.
     pub drum: DrumModel,
@@ -234,7 +234,9 @@ impl DriveConfig {
                 DriveRule::OutOfRange,
             ));
         }
-        if !(1..=SPEED_WINDOW_CAPACITY as u32).contains(&self.speed_window_ticks) {
+        if !(self.speed_window_ticks.is_power_of_two()
+            && self.speed_window_ticks <= SPEED_WINDOW_CAPACITY as u32)
+        {
             return Err(DriveConfigError::new(
                 "speed_window_ticks",
                 self.speed_window_ticks,

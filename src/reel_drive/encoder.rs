@@ -7,9 +7,13 @@
 //! - paid-out length = total count × (2π r / counts per drum revolution): no float is ever
 //!   accumulated, so the length does not drift however long the reel runs; pay out and wind
 //!   back the same counts and the length is exactly 0 again;
-//! - drum speed = (total now − total W samples ago) × m per count / ((tick now − tick then) ×
-//!   tick): a window difference of integers, so the quantisation is one count over W ticks
-//!   (15.3 µm / 8 ms ≈ 1.9 mm/s for [`DriveConfig::example`]) and nothing is integrated.
+//! - drum speed = (total now − total W ticks ago) × m per count / (W × tick): a window
+//!   difference of integers, so the quantisation is one count over W ticks (15.3 µm / 8 ms ≈
+//!   1.9 mm/s for [`DriveConfig::example`]) and nothing is integrated. The totals are kept
+//!   per tick in a ring indexed by the tick. A tick without an accepted reading (missing,
+//!   rejected, or skipped by an overrun) gets the total the window's speed predicts (its mean
+//!   change per tick, a shift: W is a power of two), so the speed holds through it instead of
+//!   dipping; the next accepted reading brings the true total back.
 //!
 //! A reading that moved further than the drum can turn in the ticks since the last accepted
 //! one (at [`FaultLimits::max_encoder_rate_mps`]) is an encoder jump: it is rejected, the total
@@ -21,16 +25,10 @@
 
 use super::config::{DriveConfig, SPEED_WINDOW_CAPACITY};
 
-/// Length of the sample history (a power of two above the largest window).
-const HISTORY: usize = 16;
-const _: () = assert!(HISTORY.is_power_of_two() && HISTORY > SPEED_WINDOW_CAPACITY);
-
-/// One accepted encoder reading.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-struct Sample {
-    tick: u32,
-    total_counts: i64,
-}
+/// Length of the ring of per-tick totals (a power of two above the largest window, so the
+/// slot of a tick is its low bits).
+const RING: usize = 16;
+const _: () = assert!(RING.is_power_of_two() && RING > SPEED_WINDOW_CAPACITY);
 
 /// Why a reading was not accepted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -49,16 +47,30 @@ pub struct Odometer {
     shift: u32,
     max_counts_per_tick: u32,
     m_per_count: f32,
-    /// m/s per count per tick: m per count / tick.
-    mps_per_count_per_tick: f32,
-    window: usize,
-    /// The last accepted raw counter value; `None` before the first reading and after a
-    /// [`resync`](Self::resync): the next reading is then the reference, not a change.
-    last_raw: Option<u32>,
-    /// The accepted readings, newest at `newest`; the reference reading fills every slot, so
-    /// the window always has a start (no count of valid entries to keep).
-    history: [Sample; HISTORY],
-    newest: usize,
+    /// m/s per count of the window: m per count / (window × tick), precomputed so that the
+    /// step has no division (VDIV: 14 cycles on the Cortex-M4F).
+    mps_per_window_count: f32,
+    window: u32,
+    /// log2 of the window (validated a power of two).
+    window_log2: u32,
+    /// The last accepted raw counter value and its tick; `None` before the first reading and
+    /// after a [`resync`](Self::resync): the next reading is then the reference, not a change.
+    accepted: Option<Accepted>,
+    /// Counts since the first reading (pay-out positive).
+    total_counts: i64,
+    /// The tick of the last update.
+    last_tick: u32,
+    /// The total at each of the last [`RING`] ticks, modulo 2³², in the slot `tick % RING`
+    /// (the window's difference of two of them is exact: it is bounded by the jump check, far
+    /// below 2³¹).
+    totals: [u32; RING],
+}
+
+/// The last accepted reading.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Accepted {
+    raw: u32,
+    tick: u32,
 }
 
 impl Odometer {
@@ -69,42 +81,88 @@ impl Odometer {
             shift: 32_u32.saturating_sub(cfg.geometry.encoder_bits),
             max_counts_per_tick: cfg.max_counts_per_tick(),
             m_per_count,
-            mps_per_count_per_tick: m_per_count * cfg.inner_rate_hz as f32,
-            window: cfg.speed_window_ticks as usize,
-            last_raw: None,
-            history: [Sample::default(); HISTORY],
-            newest: 0,
+            mps_per_window_count: m_per_count * cfg.inner_rate_hz as f32
+                / cfg.speed_window_ticks as f32,
+            window: cfg.speed_window_ticks,
+            window_log2: cfg.speed_window_ticks.trailing_zeros(),
+            accepted: None,
+            total_counts: 0,
+            last_tick: 0,
+            totals: [0; RING],
         }
     }
 
     /// Takes the counter reading of `tick` (`None`: no reading). Ticks must increase (the
     /// speed loop checks that before it calls this). The first reading sets the origin.
     pub fn update(&mut self, tick: u32, raw: Option<u32>) -> Result<(), CountFault> {
+        // Ticks skipped since the last update (rare: an overrun) get the predicted total.
+        let skipped = tick.wrapping_sub(self.last_tick).wrapping_sub(1);
+        if skipped != 0 {
+            self.fill_skipped(skipped);
+        }
+        self.last_tick = tick;
+        let result = self.count(tick, raw);
+        self.totals[tick as usize % RING] = match result {
+            Ok(()) => self.total_counts as u32,
+            Err(_) => self.unread_total(),
+        };
+        result
+    }
+
+    /// Gives the `skipped` ticks after `last_tick` their predicted totals. Out of line and
+    /// cold: an overrun is rare, and its loop kept inline costs the nominal step registers.
+    #[cold]
+    #[inline(never)]
+    fn fill_skipped(&mut self, skipped: u32) {
+        if self.accepted.is_none() {
+            // No reference: every slot already holds the total (see `resync`).
+            return;
+        }
+        for _ in 0..skipped.min(RING as u32) {
+            self.last_tick = self.last_tick.wrapping_add(1);
+            self.totals[self.last_tick as usize % RING] = self.predicted_total();
+        }
+    }
+
+    /// The total of a tick without an accepted reading: the predicted one, or, without a
+    /// reference to predict from, the total (which every slot then holds, see `resync`).
+    fn unread_total(&self) -> u32 {
+        if self.accepted.is_some() {
+            self.predicted_total()
+        } else {
+            self.total_counts as u32
+        }
+    }
+
+    /// The total at `last_tick` if the drum kept the speed of the window before it: the
+    /// previous total plus the window's mean change per tick (rounded down).
+    fn predicted_total(&self) -> u32 {
+        let previous = self.totals[self.last_tick.wrapping_sub(1) as usize % RING];
+        let then = self.totals[self.last_tick.wrapping_sub(1 + self.window) as usize % RING];
+        let per_tick = (previous.wrapping_sub(then) as i32) >> self.window_log2;
+        previous.wrapping_add(per_tick as u32)
+    }
+
+    /// The total count after the reading `raw` of `tick`, if it is accepted.
+    fn count(&mut self, tick: u32, raw: Option<u32>) -> Result<(), CountFault> {
         let raw = raw.ok_or(CountFault::Missing)?;
-        let Some(last_raw) = self.last_raw else {
-            // The reference reading: the total stays (0 at the first), the speed restarts at 0.
-            self.last_raw = Some(raw);
-            self.history = [Sample {
-                tick,
-                total_counts: self.total_counts(),
-            }; HISTORY];
+        let Some(last) = self.accepted else {
+            // The reference reading: the total stays (0 at the first). The ring already holds
+            // the total in every slot (see `resync`), so the speed restarts at 0.
+            self.accepted = Some(Accepted { raw, tick });
             return Ok(());
         };
-        let last = self.newest_sample();
         // The change modulo 2^bits, sign-extended: exact for |change| < 2^(bits−1).
         let change =
-            ((raw.wrapping_sub(last_raw).wrapping_shl(self.shift)) as i32).wrapping_shr(self.shift);
-        let gap_ticks = tick.wrapping_sub(last.tick);
-        let allowed = self.max_counts_per_tick.saturating_mul(gap_ticks);
+            ((raw.wrapping_sub(last.raw).wrapping_shl(self.shift)) as i32).wrapping_shr(self.shift);
+        let allowed = self
+            .max_counts_per_tick
+            .saturating_mul(tick.wrapping_sub(last.tick));
         if change.unsigned_abs() > allowed {
             return Err(CountFault::Jump);
         }
-        self.last_raw = Some(raw);
-        self.newest = self.newest.wrapping_add(1) & (HISTORY - 1);
-        self.history[self.newest & (HISTORY - 1)] = Sample {
-            tick,
-            total_counts: last.total_counts.wrapping_add(i64::from(change)),
-        };
+        self.accepted = Some(Accepted { raw, tick });
+        self.total_counts = self.total_counts.wrapping_add(i64::from(change));
         Ok(())
     }
 
@@ -113,44 +171,42 @@ impl Odometer {
     /// after a long gap a change of the counter is ambiguous modulo 2^bits, so the travel
     /// during the outage is not counted, and the paid-out length must be re-referenced by the
     /// outer loop's length sensor.
+    ///
+    /// Every slot of the window's ring then holds the total, and keeps holding it until the
+    /// next reading (the reference) is accepted, so that the speed restarts from 0 there; the
+    /// ring is filled here, outside the step, rather than at that reading: the fill is 16
+    /// stores in a loop, 64 instructions, which made the reference reading's step the worst of
+    /// all (208 instructions, exact, `scripts/bench-target` with `TSS_BENCH_EXACT=1`; the
+    /// construction's zeros are the first reference's total).
     pub fn resync(&mut self) {
-        self.last_raw = None;
+        self.accepted = None;
+        self.totals = [self.total_counts as u32; RING];
     }
 
     /// Ticks since the last accepted reading at `tick` (`None` before the first).
     pub fn ticks_since_accepted(&self, tick: u32) -> Option<u32> {
-        self.last_raw
-            .map(|_| tick.wrapping_sub(self.newest_sample().tick))
+        self.accepted.map(|a| tick.wrapping_sub(a.tick))
     }
 
     /// Counts since the first reading (pay-out positive).
     pub fn total_counts(&self) -> i64 {
-        self.newest_sample().total_counts
+        self.total_counts
     }
 
     /// Tether paid out since the first reading, m: total count × m per count (a function of
     /// the integer count; its error is the two roundings of this product, never accumulated).
     pub fn paid_out_m(&self) -> f32 {
-        self.total_counts() as f32 * self.m_per_count
+        self.total_counts as f32 * self.m_per_count
     }
 
-    /// Drum surface speed, m/s (pay-out positive): the count difference over the last
-    /// `speed_window_ticks` accepted readings divided by their time. 0 before the second
-    /// reading (the drum starts braked, at rest).
+    /// Drum surface speed at the last update, m/s (pay-out positive): the total's change over
+    /// the last `speed_window_ticks` ticks × m per count / their time. 0 until the window has
+    /// the second reading's tick in it (the drum starts braked, at rest).
+    #[inline]
     pub fn speed_mps(&self) -> f32 {
-        let new = self.newest_sample();
-        let old = self.history[self.newest.wrapping_sub(self.window) & (HISTORY - 1)];
-        let ticks = new.tick.wrapping_sub(old.tick);
-        if ticks == 0 {
-            return 0.0;
-        }
-        // The window's change is bounded by the jump check (≤ 2^31), so it fits an i32.
-        let counts = new.total_counts.wrapping_sub(old.total_counts) as i32;
-        counts as f32 * self.mps_per_count_per_tick / ticks as f32
-    }
-
-    fn newest_sample(&self) -> Sample {
-        self.history[self.newest & (HISTORY - 1)]
+        let now = self.totals[self.last_tick as usize % RING];
+        let then = self.totals[self.last_tick.wrapping_sub(self.window) as usize % RING];
+        now.wrapping_sub(then) as i32 as f32 * self.mps_per_window_count
     }
 }
 

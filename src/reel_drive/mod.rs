@@ -56,6 +56,7 @@
 pub mod config;
 pub mod encoder;
 pub mod hal;
+pub mod sim;
 
 pub use config::{
     BrakeConfig, DriveConfig, DriveConfigError, DriveRule, DrumModel, FaultLimits, Geometry,
@@ -166,18 +167,25 @@ pub enum DriveFault {
     Actuator,
 }
 
-/// What the outer controller should make of a drive fault.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// What the outer controller makes of a drive fault (applied by
+/// [`Controller::step_with_drive`](crate::controller::Controller::step_with_drive)). Ordered:
+/// the strongest reaction of a period's faults wins.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum OuterReaction {
-    /// Telemetry only: the drive copes (the outer envelope and length monitor cover it).
+    /// Telemetry only: the drive copes (the fault is the caller's own, and its safe action is
+    /// already taken by the drive).
     Report,
-    /// The reel's length (from this encoder) or its motion cannot be trusted this period: the
-    /// caller steps the outer controller with
-    /// [`Controller::step_missing`](crate::controller::Controller::step_missing), so it coasts
-    /// (`Health::Degraded`, `Fault::Sensor(Sensor::Missing)`) and, if the fault persists past
-    /// `coast_ticks`, goes to `Health::SafeHold`, whose zero command keeps the brake engaged.
-    LengthSampleMissing,
+    /// The period's reel data (the encoder's length, the drum's motion) cannot be trusted, or
+    /// the drum cannot follow the command: the period is a missing sample for the outer
+    /// controller, which coasts (`Health::Degraded`, `Fault::Sensor(Sensor::Missing)`) and, if
+    /// the fault persists past `coast_ticks` (its leaky counter), goes to `Health::SafeHold`.
+    Degrade,
+    /// The drive tripped (motor off, brake on): the reel cannot move, so the law's command
+    /// means nothing. `Health::SafeHold` at once (its zero command keeps the brake engaged
+    /// once the trip is cleared), left only after `recovery_ticks` valid periods in a row
+    /// without a trip.
+    SafeHold,
 }
 
 impl DriveFault {
@@ -193,23 +201,23 @@ impl DriveFault {
         Self::Actuator,
     ];
 
-    /// The mapping onto the outer fault logic:
+    /// The mapping onto the outer fault logic (docs/hazards.md for the hazards):
     ///
-    /// | fault | reaction | outer hazard |
-    /// |---|---|---|
-    /// | `EncoderJump`, `EncoderMissing` | [`OuterReaction::LengthSampleMissing`] | HZ-1 / HZ-6 |
-    /// | `MotorStall`, `Actuator` | [`OuterReaction::LengthSampleMissing`] (the drive tripped) | HZ-7 |
-    /// | `DutySaturated` | [`OuterReaction::Report`] | HZ-7 |
-    /// | `TensionOutOfRange` | [`OuterReaction::Report`] | HZ-10 |
-    /// | `Tick`, `CommandInvalid` | [`OuterReaction::Report`] (the caller's own error) | HZ-12 |
+    /// | fault | reaction | why | hazard |
+    /// |---|---|---|---|
+    /// | `EncoderJump`, `EncoderMissing` | [`OuterReaction::Degrade`] | the length sample comes from this encoder | HZ-1 / HZ-6 |
+    /// | `DutySaturated` | [`OuterReaction::Degrade`] | the drum does not follow the command: coast on the last one, safe hold if it lasts | HZ-7 |
+    /// | `TensionOutOfRange` | [`OuterReaction::Degrade`] | slack, break or overload: the law's model does not hold | HZ-10 |
+    /// | `MotorStall`, `Actuator` | [`OuterReaction::SafeHold`] | the drive tripped: the reel cannot move | HZ-7 |
+    /// | `Tick`, `CommandInvalid` | [`OuterReaction::Report`] | the caller's own error; the drive already holds | HZ-12 |
     pub fn outer_reaction(self) -> OuterReaction {
         match self {
-            Self::EncoderJump | Self::EncoderMissing | Self::MotorStall | Self::Actuator => {
-                OuterReaction::LengthSampleMissing
-            }
-            Self::Tick | Self::DutySaturated | Self::TensionOutOfRange | Self::CommandInvalid => {
-                OuterReaction::Report
-            }
+            Self::MotorStall | Self::Actuator => OuterReaction::SafeHold,
+            Self::EncoderJump
+            | Self::EncoderMissing
+            | Self::DutySaturated
+            | Self::TensionOutOfRange => OuterReaction::Degrade,
+            Self::Tick | Self::CommandInvalid => OuterReaction::Report,
         }
     }
 
@@ -251,18 +259,26 @@ impl DriveFaults {
 
     /// The strongest reaction any fault of the set asks of the outer controller.
     pub fn outer_reaction(self) -> OuterReaction {
-        if self
-            .iter()
-            .any(|f| f.outer_reaction() == OuterReaction::LengthSampleMissing)
-        {
-            OuterReaction::LengthSampleMissing
-        } else {
-            OuterReaction::Report
-        }
+        self.iter()
+            .map(DriveFault::outer_reaction)
+            .max()
+            .unwrap_or(OuterReaction::Report)
+    }
+
+    /// The set as bits, one per fault in [`DriveFault::ALL`] order (for telemetry).
+    pub fn bits(self) -> u16 {
+        self.0
+    }
+
+    /// The union of two sets (a period's faults are the union of its ticks').
+    pub fn union(self, other: Self) -> Self {
+        Self(self.0 | other.0)
     }
 }
 
-/// What one inner step decided, and why: the duty and the parts it was made of.
+/// What one inner step decided: the reference, the measurements it used, the duty and the
+/// brake. (The torque's parts are worked out on demand, [`SpeedLoop::torque_parts`], not every
+/// tick.)
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct DriveOutput {
@@ -274,22 +290,10 @@ pub struct DriveOutput {
     pub ref_accel_mps2: f32,
     /// Measured drum surface speed v, m/s.
     pub speed_mps: f32,
-    /// v_ref − v, m/s.
-    pub error_mps: f32,
-    /// Proportional part, N m.
-    pub p_nm: f32,
-    /// Integral part, N m.
-    pub i_nm: f32,
-    /// Inertia feed-forward J a_ref / r, N m.
-    pub ff_inertia_nm: f32,
-    /// Tension feed-forward −T r, N m.
-    pub ff_tension_nm: f32,
-    /// Friction feed-forward b v_ref / r + c sat(v_ref / v_band), N m.
-    pub ff_friction_nm: f32,
     /// The tension the feed-forward used (the reading, clamped into range, or the last good
     /// one), N.
     pub tension_n: f32,
-    /// The sum of the parts before saturation, N m.
+    /// The drum torque asked for before saturation (PI + feed-forward), N m.
     pub torque_nm: f32,
     /// Motor duty in [−duty_limit, duty_limit] (sign = direction, pay-out positive).
     pub duty: f32,
@@ -307,12 +311,6 @@ impl DriveOutput {
         ref_rate_mps: 0.0,
         ref_accel_mps2: 0.0,
         speed_mps: 0.0,
-        error_mps: 0.0,
-        p_nm: 0.0,
-        i_nm: 0.0,
-        ff_inertia_nm: 0.0,
-        ff_tension_nm: 0.0,
-        ff_friction_nm: 0.0,
         tension_n: 0.0,
         torque_nm: 0.0,
         duty: 0.0,
@@ -320,6 +318,25 @@ impl DriveOutput {
         brake: Brake::Engaged,
         faults: DriveFaults::NONE,
     };
+}
+
+/// The parts the last step's torque was made of (telemetry: [`SpeedLoop::torque_parts`]).
+/// Their sum is [`DriveOutput::torque_nm`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct TorqueParts {
+    /// v_ref − v, m/s.
+    pub error_mps: f32,
+    /// Proportional part, N m.
+    pub p_nm: f32,
+    /// Integral part, N m.
+    pub i_nm: f32,
+    /// Inertia feed-forward J a_ref / r, N m.
+    pub ff_inertia_nm: f32,
+    /// Tension feed-forward −T r, N m.
+    pub ff_tension_nm: f32,
+    /// Friction feed-forward b v_ref / r + c sat(v_ref / v_band), N m.
+    pub ff_friction_nm: f32,
 }
 
 /// The ramp the reference follows toward the commanded rate.
@@ -332,19 +349,38 @@ struct Ramp {
     target_mps: f32,
     /// Signed slope toward the target (0 if already there), m/s².
     slope_mps2: f32,
+    /// The slope × tick: the reference's change per tick, m/s.
+    step_mps: f32,
     /// Ticks from `start_tick` until the target is reached (integer time: the reference is the
     /// target from then on, and never passes it before).
     ramp_ticks: u32,
 }
 
-/// Constants derived once from the configuration.
+impl Ramp {
+    const REST: Self = Self {
+        start_mps: 0.0,
+        start_tick: 0,
+        target_mps: 0.0,
+        slope_mps2: 0.0,
+        step_mps: 0.0,
+        ramp_ticks: 0,
+    };
+}
+
+/// Constants derived once from the configuration, so that the step has no division.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Derived {
     tick_s: f32,
     outer_period_per_s: f32,
+    /// ki × tick: the integral's growth per tick and m/s of error, N m.
+    ki_tick: f32,
+    /// J / r: inertia feed-forward per m/s².
     inertia_per_radius: f32,
+    /// b / r: viscous feed-forward per m/s.
     viscous_per_radius: f32,
+    /// c / v_band: Coulomb feed-forward per m/s inside the band.
     coulomb_per_band: f32,
+    /// 1 / τ_max: duty per N m.
     per_max_torque: f32,
 }
 
@@ -356,9 +392,16 @@ pub struct SpeedLoop {
     odometer: Odometer,
     /// The last command, as received (after sanitising).
     command: RateCommand,
-    /// The last command was not finite (until a finite one arrives).
-    command_invalid: bool,
+    /// The command asks for motion: |rate| above the brake's rest speed.
+    command_moving: bool,
+    /// The faults every step reports until the next command: [`DriveFault::CommandInvalid`]
+    /// after a non-finite one, none otherwise.
+    command_faults: DriveFaults,
+    /// The reference's ramp now.
     ramp: Ramp,
+    /// The ramp from rest to the command (its `start_tick` set when the brake is free): worked
+    /// out with the command, so that the release's step has no division.
+    ramp_from_rest: Ramp,
     integral_nm: f32,
     /// The tension the feed-forward uses (the last good reading, clamped into range), N.
     tension_n: f32,
@@ -377,6 +420,7 @@ impl SpeedLoop {
         let derived = Derived {
             tick_s: cfg.tick_s(),
             outer_period_per_s: cfg.inner_rate_hz as f32 / cfg.outer_period_ticks as f32,
+            ki_tick: cfg.gains.ki_nm_per_m * cfg.tick_s(),
             inertia_per_radius: cfg.drum.inertia_kgm2 / r,
             viscous_per_radius: cfg.drum.viscous_nm_per_radps / r,
             coulomb_per_band: cfg.drum.coulomb_nm / cfg.drum.coulomb_band_mps,
@@ -391,14 +435,10 @@ impl SpeedLoop {
                 accel_mps2: 0.0,
                 safe_hold: false,
             },
-            command_invalid: false,
-            ramp: Ramp {
-                start_mps: 0.0,
-                start_tick: 0,
-                target_mps: 0.0,
-                slope_mps2: 0.0,
-                ramp_ticks: 0,
-            },
+            command_moving: false,
+            command_faults: DriveFaults::NONE,
+            ramp: Ramp::REST,
+            ramp_from_rest: Ramp::REST,
             integral_nm: 0.0,
             tension_n: 0.0,
             last_tick: None,
@@ -429,28 +469,56 @@ impl SpeedLoop {
         self.brake
     }
 
+    /// The parts of the last step's torque ([`DriveOutput::torque_nm`] is their sum): with
+    /// the brake free, PI and the three feed-forwards; while it lifts, only the tension's;
+    /// otherwise none.
+    pub fn torque_parts(&self) -> TorqueParts {
+        let o = &self.out;
+        match o.brake {
+            Brake::Released { .. } => {
+                let error_mps = o.ref_rate_mps - o.speed_mps;
+                TorqueParts {
+                    error_mps,
+                    p_nm: self.cfg.gains.kp_nm_per_mps * error_mps,
+                    i_nm: self.integral_nm,
+                    ff_inertia_nm: self.derived.inertia_per_radius * o.ref_accel_mps2,
+                    ff_tension_nm: self.tension_torque_nm(o.tension_n),
+                    ff_friction_nm: self.friction_torque_nm(o.ref_rate_mps),
+                }
+            }
+            Brake::Releasing { .. } => TorqueParts {
+                ff_tension_nm: self.tension_torque_nm(o.tension_n),
+                ..TorqueParts::default()
+            },
+            Brake::Engaged | Brake::Tripped(_) => TorqueParts::default(),
+        }
+    }
+
     /// Takes a new rate command at inner tick `tick` (normally once a law period). The
     /// reference ramps from where it is now toward it (see the module docs). A non-finite rate
     /// or acceleration is [`DriveFault::CommandInvalid`] (returned, and reported by every step
     /// until a finite command arrives): the drum is then brought to rest as in safe hold.
     pub fn set_command(&mut self, cmd: RateCommand, tick: u32) -> Result<(), DriveFault> {
         let valid = cmd.rate_mps.is_finite() && cmd.accel_mps2.is_finite();
-        self.command_invalid = !valid;
         let max = self.cfg.max_speed_mps;
+        self.command_faults = DriveFaults::NONE;
         self.command = if valid {
             RateCommand {
-                rate_mps: cmd.rate_mps.max(-max).min(max),
+                rate_mps: clamp_abs(cmd.rate_mps, max),
                 ..cmd
             }
         } else {
+            self.command_faults.insert(DriveFault::CommandInvalid);
             RateCommand {
                 rate_mps: 0.0,
                 accel_mps2: 0.0,
                 safe_hold: true,
             }
         };
+        self.command_moving = self.command.rate_mps.abs() > self.cfg.brake.rest_speed_mps;
         let (now_mps, _) = self.reference_at(tick);
-        self.anchor(now_mps, tick);
+        self.ramp = self.ramp_toward_command(now_mps, tick);
+        self.ramp_from_rest = self.ramp_toward_command(0.0, tick);
         if valid {
             Ok(())
         } else {
@@ -486,135 +554,93 @@ impl SpeedLoop {
         }
     }
 
-    /// One inner tick: odometry, reference, brake, PI + feed-forward, faults. The duty and
+    /// One inner tick: odometry, brake, reference, PI + feed-forward, faults. The duty and
     /// brake in the output are what the hardware is to be set to.
     pub fn step(&mut self, input: &DriveInput) -> &DriveOutput {
         let tick = input.tick;
-        let mut faults = DriveFaults::NONE;
-        if self.command_invalid {
-            faults.insert(DriveFault::CommandInvalid);
-        }
         // Integer time: the tick must advance (wrapping, by less than half the range).
         let gap_ticks = match self.last_tick {
             None => 1,
-            Some(last) => {
-                let gap = tick.wrapping_sub(last);
-                if gap == 0 || gap > i32::MAX as u32 {
-                    faults.insert(DriveFault::Tick);
-                    self.out.faults = faults;
-                    return &self.out;
-                }
-                gap
-            }
+            Some(last) => tick.wrapping_sub(last),
         };
+        // (0 and anything beyond half the range in one comparison: 0 − 1 wraps to the top.)
+        if gap_ticks.wrapping_sub(1) >= i32::MAX as u32 {
+            return self.reject_tick();
+        }
         self.last_tick = Some(tick);
+        let mut faults = self.command_faults;
 
-        // Odometry. A gap longer than the encoder check can bridge loses the count.
+        // Odometry: a reading the odometer cannot take is a fault; too long without one trips.
+        // After a gap longer than the jump check bridges, the counter's change is ambiguous
+        // (it may have wrapped): the reading is not used.
         let trip_ticks = self.cfg.faults.encoder_trip_ticks;
-        let count = if gap_ticks > trip_ticks {
-            Err(CountFault::Missing)
+        let reading = if gap_ticks <= trip_ticks {
+            input.encoder_count
         } else {
-            self.odometer.update(tick, input.encoder_count)
+            None
         };
-        match count {
-            Ok(()) => {}
-            Err(CountFault::Jump) => faults.insert(DriveFault::EncoderJump),
-            Err(CountFault::Missing) => faults.insert(DriveFault::EncoderMissing),
+        let counted = self.odometer.update(tick, reading);
+        if let Err(f) = counted {
+            let fault = match f {
+                CountFault::Jump => DriveFault::EncoderJump,
+                CountFault::Missing => DriveFault::EncoderMissing,
+            };
+            faults.insert(fault);
+            let lost = gap_ticks > trip_ticks
+                || self
+                    .odometer
+                    .ticks_since_accepted(tick)
+                    .is_some_and(|t| t > trip_ticks);
+            if lost {
+                self.trip(fault);
+            }
         }
         let speed_mps = self.odometer.speed_mps();
-        let encoder_lost = gap_ticks > trip_ticks
-            || self
-                .odometer
-                .ticks_since_accepted(tick)
-                .is_some_and(|t| t > trip_ticks);
-        if encoder_lost {
-            let fault = match count {
-                Err(CountFault::Jump) => DriveFault::EncoderJump,
-                _ => DriveFault::EncoderMissing,
-            };
-            self.trip(fault);
-        }
-
         let tension_n = self.tension(input.tension_n, &mut faults);
-        let (mut ramp_mps, mut ramp_accel_mps2) = self.reference_at(tick);
-        let was_released = matches!(self.brake, Brake::Released { .. });
-        self.brake = self.next_brake(tick, gap_ticks, ramp_mps, speed_mps, count.is_ok());
-        if !was_released && matches!(self.brake, Brake::Released { .. }) {
-            // Just released: the ramp restarted from rest at this tick.
-            (ramp_mps, ramp_accel_mps2) = self.reference_at(tick);
-        }
 
-        let d = self.derived;
-        let max_torque_nm = self.cfg.max_torque_nm;
-        let limit = self.cfg.duty_limit;
-        let mut ref_mps = 0.0;
-        let mut ref_accel_mps2 = 0.0;
-        let mut p_nm = 0.0;
-        let mut ff_inertia_nm = 0.0;
-        let mut ff_tension_nm = 0.0;
-        let mut ff_friction_nm = 0.0;
-        match self.brake {
-            Brake::Released { .. } => {
-                ref_mps = ramp_mps;
-                ref_accel_mps2 = ramp_accel_mps2;
-                p_nm = self.cfg.gains.kp_nm_per_mps * (ref_mps - speed_mps);
-                ff_inertia_nm = d.inertia_per_radius * ref_accel_mps2;
-                ff_tension_nm = -tension_n * self.cfg.geometry.drum_radius_m;
-                let coulomb_nm = clamp_abs(ref_mps * d.coulomb_per_band, self.cfg.drum.coulomb_nm);
-                ff_friction_nm = d.viscous_per_radius * ref_mps + coulomb_nm;
-            }
-            // The brake lifts: the motor takes over the tension's torque, nothing else.
-            Brake::Releasing { .. } => {
-                ff_tension_nm = -tension_n * self.cfg.geometry.drum_radius_m;
+        self.brake = self.next_brake(tick, gap_ticks, speed_mps, counted.is_ok());
+
+        // The torque: PI + feed-forward with the brake free; while it lifts, the motor takes
+        // over the tension's torque, nothing else; otherwise the motor is off.
+        let (ref_mps, ref_accel_mps2, torque_nm) = match self.brake {
+            Brake::Released { .. } => self.speed_law(tick, gap_ticks, speed_mps, tension_n),
+            Brake::Releasing { .. } => (0.0, 0.0, self.tension_torque_nm(tension_n)),
+            Brake::Engaged => {
                 self.integral_nm = 0.0;
+                (0.0, 0.0, 0.0)
             }
-            // The motor is off.
-            Brake::Engaged | Brake::Tripped(_) => self.integral_nm = 0.0,
-        }
-        let error_mps = ref_mps - speed_mps;
-        let without_i_nm = p_nm + ff_inertia_nm + ff_tension_nm + ff_friction_nm;
-        if matches!(self.brake, Brake::Released { .. }) {
-            // Conditional integration: no growth that pushes a saturated output further out.
-            let dt_s = gap_ticks as f32 * d.tick_s;
-            let candidate = clamp_abs(
-                self.integral_nm + self.cfg.gains.ki_nm_per_m * error_mps * dt_s,
-                max_torque_nm,
-            );
-            let duty = (without_i_nm + candidate) * d.per_max_torque;
-            let winding_up = duty.abs() > limit && duty * error_mps > 0.0;
-            if !winding_up {
-                self.integral_nm = candidate;
+            Brake::Tripped(f) => {
+                faults.insert(f);
+                self.integral_nm = 0.0;
+                (0.0, 0.0, 0.0)
             }
-        }
-        let torque_nm = without_i_nm + self.integral_nm;
-        let raw_duty = torque_nm * d.per_max_torque;
-        let saturated = raw_duty.abs() > limit;
-        let mut duty = clamp_abs(raw_duty, limit);
+        };
+        let (mut duty, saturated) =
+            saturate(torque_nm * self.derived.per_max_torque, self.cfg.duty_limit);
 
-        // Saturation held too long (reported), stall (trips).
-        self.saturated_ticks = if saturated {
-            self.saturated_ticks.saturating_add(gap_ticks)
-        } else {
-            0
-        };
-        if self.saturated_ticks >= self.cfg.faults.saturation_ticks {
-            faults.insert(DriveFault::DutySaturated);
-        }
+        // Saturation held too long (reported), stall (trips). The counters are only touched
+        // beyond resetting them when their condition holds (rare).
         let f = &self.cfg.faults;
-        let stalled = matches!(self.brake, Brake::Released { .. })
-            && duty.abs() >= f.stall_duty
-            && speed_mps.abs() <= f.stall_speed_mps;
-        self.stall_ticks = if stalled {
-            self.stall_ticks.saturating_add(gap_ticks)
+        if saturated {
+            self.saturated_ticks = self.saturated_ticks.saturating_add(gap_ticks);
+            if self.saturated_ticks >= f.saturation_ticks {
+                faults.insert(DriveFault::DutySaturated);
+            }
         } else {
-            0
-        };
-        if self.stall_ticks >= f.stall_ticks {
-            self.trip(DriveFault::MotorStall);
+            self.saturated_ticks = 0;
         }
-        if let Brake::Tripped(f) = self.brake {
-            faults.insert(f);
-            duty = 0.0;
+        let stalled = duty.abs() >= f.stall_duty
+            && speed_mps.abs() <= f.stall_speed_mps
+            && matches!(self.brake, Brake::Released { .. });
+        if stalled {
+            self.stall_ticks = self.stall_ticks.saturating_add(gap_ticks);
+            if self.stall_ticks >= f.stall_ticks {
+                self.trip(DriveFault::MotorStall);
+                faults.insert(DriveFault::MotorStall);
+                duty = 0.0;
+            }
+        } else {
+            self.stall_ticks = 0;
         }
 
         self.out = DriveOutput {
@@ -622,12 +648,6 @@ impl SpeedLoop {
             ref_rate_mps: ref_mps,
             ref_accel_mps2,
             speed_mps,
-            error_mps,
-            p_nm,
-            i_nm: self.integral_nm,
-            ff_inertia_nm,
-            ff_tension_nm,
-            ff_friction_nm,
             tension_n,
             torque_nm,
             duty,
@@ -638,9 +658,63 @@ impl SpeedLoop {
         &self.out
     }
 
+    /// A tick that did not advance: nothing is done, the last output stands, with
+    /// [`DriveFault::Tick`]. Cold, out of line (as the other rare paths of the step: its
+    /// registers are the nominal path's; 7 instructions less a step with the three of them,
+    /// `examples/bench_speed_loop.rs`).
+    #[cold]
+    #[inline(never)]
+    fn reject_tick(&mut self) -> &DriveOutput {
+        let mut faults = self.command_faults;
+        faults.insert(DriveFault::Tick);
+        self.out.faults = faults;
+        &self.out
+    }
+
     /// Tether paid out since the first encoder reading, m (a function of the integer count).
     pub fn paid_out_m(&self) -> f32 {
         self.odometer.paid_out_m()
+    }
+
+    /// The brake free: the reference at `tick`, and PI + feed-forward toward it (see the module
+    /// docs), with conditional integration: the integral does not grow in the direction that
+    /// held the last tick's duty in saturation. Returns v_ref, a_ref and the torque, N m.
+    fn speed_law(
+        &mut self,
+        tick: u32,
+        gap_ticks: u32,
+        speed_mps: f32,
+        tension_n: f32,
+    ) -> (f32, f32, f32) {
+        let (ref_mps, ref_accel_mps2) = self.reference_at(tick);
+        let error_mps = ref_mps - speed_mps;
+        let last = &self.out;
+        let winding_up = last.saturated && last.duty * error_mps > 0.0;
+        if !winding_up {
+            let growth_nm = self.derived.ki_tick * gap_ticks as f32 * error_mps;
+            // (Finite: the error and the gains are.)
+            self.integral_nm =
+                clamp_finite_abs(self.integral_nm + growth_nm, self.cfg.max_torque_nm);
+        }
+        let torque_nm = self.cfg.gains.kp_nm_per_mps * error_mps
+            + self.integral_nm
+            + self.derived.inertia_per_radius * ref_accel_mps2
+            + self.tension_torque_nm(tension_n)
+            + self.friction_torque_nm(ref_mps);
+        (ref_mps, ref_accel_mps2, torque_nm)
+    }
+
+    /// Tension feed-forward −T r, N m.
+    fn tension_torque_nm(&self, tension_n: f32) -> f32 {
+        -tension_n * self.cfg.geometry.drum_radius_m
+    }
+
+    /// Friction feed-forward b v_ref / r + c sat(v_ref / v_band), N m.
+    fn friction_torque_nm(&self, ref_mps: f32) -> f32 {
+        let d = &self.derived;
+        // (Finite: the reference is.)
+        let coulomb_nm = clamp_finite_abs(ref_mps * d.coulomb_per_band, self.cfg.drum.coulomb_nm);
+        d.viscous_per_radius * ref_mps + coulomb_nm
     }
 
     /// The tension the feed-forward uses: a reading inside [min, max] as is; a finite one
@@ -651,7 +725,7 @@ impl SpeedLoop {
         match reading {
             Some(t) if (lo..=hi).contains(&t) => self.tension_n = t,
             Some(t) if t.is_finite() => {
-                self.tension_n = t.max(lo).min(hi);
+                self.tension_n = if t < lo { lo } else { hi };
                 faults.insert(DriveFault::TensionOutOfRange);
             }
             _ => faults.insert(DriveFault::TensionOutOfRange),
@@ -660,18 +734,11 @@ impl SpeedLoop {
     }
 
     /// The brake's next state (see [`Brake`]).
-    /// Entering `Released` restarts the ramp from rest at `tick` (the drum was held until now).
-    fn next_brake(
-        &mut self,
-        tick: u32,
-        gap_ticks: u32,
-        ref_mps: f32,
-        speed_mps: f32,
-        counted: bool,
-    ) -> Brake {
-        let rest = self.cfg.brake.rest_speed_mps;
+    /// Entering `Released` starts the ramp from rest at `tick` (the drum was held until now).
+    /// At rest means the command, the last reference and the measured speed all ~0.
+    fn next_brake(&mut self, tick: u32, gap_ticks: u32, speed_mps: f32, counted: bool) -> Brake {
         let hold = self.command.safe_hold;
-        let target_moving = self.command.rate_mps.abs() > rest;
+        let target_moving = self.command_moving;
         match self.brake {
             Brake::Tripped(f) => Brake::Tripped(f),
             Brake::Engaged => {
@@ -687,7 +754,10 @@ impl SpeedLoop {
                 if !target_moving || hold {
                     Brake::Engaged
                 } else if ticks_left <= gap_ticks {
-                    self.anchor(0.0, tick);
+                    self.ramp = Ramp {
+                        start_tick: tick,
+                        ..self.ramp_from_rest
+                    };
                     Brake::Released { rest_ticks: 0 }
                 } else {
                     Brake::Releasing {
@@ -696,7 +766,10 @@ impl SpeedLoop {
                 }
             }
             Brake::Released { rest_ticks } => {
-                let at_rest = !target_moving && ref_mps.abs() <= rest && speed_mps.abs() <= rest;
+                // At rest: the command is rest and the drum is at rest (its reference, which
+                // it follows, is on its way there; waiting for it as well made the step's
+                // worst path 5 instructions longer, `examples/bench_speed_loop.rs`).
+                let at_rest = !target_moving && speed_mps.abs() <= self.cfg.brake.rest_speed_mps;
                 if !at_rest {
                     Brake::Released { rest_ticks: 0 }
                 } else {
@@ -711,10 +784,10 @@ impl SpeedLoop {
         }
     }
 
-    /// Restarts the ramp from `start_mps` at `tick` toward the command: its slope is the
-    /// command's (Eq. 30) acceleration if that points toward the command, at least what reaches
-    /// the command within one law period, at most `max_accel_mps2`.
-    fn anchor(&mut self, start_mps: f32, tick: u32) {
+    /// The ramp from `start_mps` at `tick` toward the command: its slope is the command's
+    /// (Eq. 30) acceleration if that points toward the command, at least what reaches the
+    /// command within one law period, at most `max_accel_mps2`.
+    fn ramp_toward_command(&self, start_mps: f32, tick: u32) -> Ramp {
         let target = self.command.rate_mps;
         let dv = target - start_mps;
         let law = if self.command.accel_mps2 * dv > 0.0 {
@@ -728,17 +801,19 @@ impl SpeedLoop {
         // Whole ticks to the target, rounded up (`as` saturates; 0 when already there).
         let ticks = dv.abs() / magnitude * self.cfg.inner_rate_hz as f32;
         let whole = ticks as u32;
-        self.ramp = Ramp {
+        let slope_mps2 = magnitude.copysign(dv);
+        Ramp {
             start_mps,
             start_tick: tick,
             target_mps: target,
-            slope_mps2: magnitude.copysign(dv),
+            slope_mps2,
+            step_mps: slope_mps2 * self.derived.tick_s,
             ramp_ticks: if (whole as f32) < ticks {
                 whole.saturating_add(1)
             } else {
                 whole
             },
-        };
+        }
     }
 
     /// The reference speed and acceleration at `tick`: the ramp, stopped at its target. (Only
@@ -749,23 +824,40 @@ impl SpeedLoop {
         if age_ticks >= r.ramp_ticks {
             (r.target_mps, 0.0)
         } else {
-            let age_s = age_ticks as f32 * self.derived.tick_s;
-            (r.start_mps + r.slope_mps2 * age_s, r.slope_mps2)
+            (r.start_mps + r.step_mps * age_ticks as f32, r.slope_mps2)
         }
     }
 }
 
-/// `x` limited to [−limit, limit] (limit ≥ 0), by comparisons: `f32::clamp` panics on bad
-/// bounds, and `f32::min`/`max` are library calls (`fminf`/`fmaxf`) on the Cortex-M4F — with
-/// them the step took 420 instructions (median, `examples/bench_speed_loop.rs`), 328 with
-/// this and the reference evaluated once. A NaN `x` gives 0 (no torque).
+/// `x` limited to [−limit, limit] (limit ≥ 0), and whether it was beyond: by comparisons,
+/// which decide both at once (`f32::clamp` panics on bad bounds, and `f32::min`/`max` are
+/// library calls, `fminf`/`fmaxf`, on the Cortex-M4F: with them the step took 420 instructions,
+/// median, `examples/bench_speed_loop.rs`). A NaN `x` gives 0 (no torque), not saturated.
+fn saturate(x: f32, limit: f32) -> (f32, bool) {
+    if x > limit {
+        (limit, true)
+    } else if x < -limit {
+        (-limit, true)
+    } else if x.is_nan() {
+        (0.0, false)
+    } else {
+        (x, false)
+    }
+}
+
+/// [`saturate`]'s value.
 fn clamp_abs(x: f32, limit: f32) -> f32 {
+    saturate(x, limit).0
+}
+
+/// A finite `x` limited to [−limit, limit] (limit ≥ 0): [`clamp_abs`] without its NaN check,
+/// for values finite by construction (every input is checked before it reaches the law), 4
+/// instructions less a use (`examples/bench_speed_loop.rs`). A NaN `x` stays NaN.
+fn clamp_finite_abs(x: f32, limit: f32) -> f32 {
     if x > limit {
         limit
     } else if x < -limit {
         -limit
-    } else if x.is_nan() {
-        0.0
     } else {
         x
     }
@@ -818,12 +910,19 @@ mod tests {
     fn the_faults_map_onto_the_outer_logic() {
         let mut set = DriveFaults::NONE;
         set.insert(DriveFault::TensionOutOfRange);
-        assert_eq!(set.outer_reaction(), OuterReaction::Report);
+        assert_eq!(DriveFaults::NONE.outer_reaction(), OuterReaction::Report);
+        assert_eq!(set.outer_reaction(), OuterReaction::Degrade);
         set.insert(DriveFault::EncoderJump);
-        assert_eq!(set.outer_reaction(), OuterReaction::LengthSampleMissing);
+        assert_eq!(set.outer_reaction(), OuterReaction::Degrade);
+        set.insert(DriveFault::MotorStall);
+        assert_eq!(set.outer_reaction(), OuterReaction::SafeHold);
         assert_eq!(
             set.iter().collect::<heapless::Vec<_, 8>>().as_slice(),
-            &[DriveFault::EncoderJump, DriveFault::TensionOutOfRange]
+            &[
+                DriveFault::EncoderJump,
+                DriveFault::MotorStall,
+                DriveFault::TensionOutOfRange
+            ]
         );
     }
 }

@@ -153,6 +153,203 @@ impl DrumParams {
     }
 }
 
+/// The flight speed loop on this drum: `tss_reel::reel_drive::SpeedLoop` (f32, the reel MCU's
+/// code) closes the loop at its inner rate, reading a quantised encoder (the drum's angle
+/// floored to whole counts, in a wrapping counter) and the tension at the reel, and its duty
+/// becomes the motor torque, held over the tick (the drum's own PI loop above is not used).
+/// The drum integrates with the stick–slip rules of [`DrumParams`], `substeps` semi-implicit
+/// Euler steps per inner tick, the spring brake held whenever the drive has it engaged.
+///
+/// It flies one law period at a time ([`FlightDrum::period`]), the tension held over it, and
+/// keeps the figures the summary reports ([`DriveFigures`]).
+#[derive(Clone, Debug)]
+pub struct FlightDrum {
+    params: DrumParams,
+    speed: tss_reel::reel_drive::SpeedLoop,
+    motion: Motion,
+    rate_radps: f64,
+    /// The drum's angle in encoder counts (f64: exact to a count for 2^52 counts).
+    angle_counts: f64,
+    counts_per_rad: f64,
+    encoder_mask: u32,
+    /// Duty → drum torque, N·m at duty 1 (the drive's `max_torque_nm`).
+    torque_per_duty_nm: f64,
+    tick: u32,
+    substeps: u32,
+    figures: DriveFigures,
+}
+
+/// What the flight drive did over the periods flown: tracking, saturation, tension, faults.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DriveFigures {
+    /// Inner ticks flown with the brake released (the tracking statistics' population).
+    pub released_ticks: u64,
+    /// Inner ticks flown in all.
+    pub ticks: u64,
+    /// Σ (drum speed − reference)² over the released ticks, (m/s)².
+    pub sum_sq_error: f64,
+    /// Largest |drum speed − reference| over the released ticks, m/s.
+    pub max_error_mps: f64,
+    /// Largest |drum speed − law's command| at the end of a law period (the drive's own
+    /// ramp included), m/s.
+    pub max_period_end_error_mps: f64,
+    /// Ticks with the duty saturated.
+    pub saturated_ticks: u64,
+    /// Least and largest tension at the reel the drive saw, N.
+    pub tension_range_n: (f64, f64),
+    /// Every drive fault seen (bits of `tss_reel::reel_drive::DriveFaults`).
+    pub fault_bits: u16,
+}
+
+impl DriveFigures {
+    /// RMS of the tracking error over the released ticks, m/s.
+    pub fn rms_error_mps(&self) -> f64 {
+        if self.released_ticks == 0 {
+            0.0
+        } else {
+            (self.sum_sq_error / self.released_ticks as f64).sqrt()
+        }
+    }
+
+    /// The fraction of ticks with the duty saturated.
+    pub fn saturated_fraction(&self) -> f64 {
+        if self.ticks == 0 {
+            0.0
+        } else {
+            self.saturated_ticks as f64 / self.ticks as f64
+        }
+    }
+}
+
+impl FlightDrum {
+    /// The drive configuration for this drum: the reference reel's
+    /// (`DriveConfig::example`) with the drum's radius, inertia, friction and torque limit,
+    /// the PI crossing over at the same 30 rad/s (kp = 30 J / r, its zero at a quarter of
+    /// that), at `inner_rate_hz` under a law period of `period_s`.
+    pub fn drive_config(
+        params: &DrumParams,
+        inner_rate_hz: u32,
+        period_s: f64,
+    ) -> tss_reel::reel_drive::DriveConfig {
+        let mut cfg = tss_reel::reel_drive::DriveConfig::example();
+        cfg.inner_rate_hz = inner_rate_hz;
+        cfg.outer_period_ticks = (period_s * f64::from(inner_rate_hz)).round() as u32;
+        cfg.geometry.drum_radius_m = params.radius_m as f32;
+        cfg.drum.inertia_kgm2 = params.inertia_kgm2 as f32;
+        cfg.drum.viscous_nm_per_radps = params.viscous_nms as f32;
+        cfg.drum.coulomb_nm = params.coulomb_nm as f32;
+        cfg.max_torque_nm = params.max_torque_nm as f32;
+        let crossover_radps = 30.0;
+        let kp = crossover_radps * params.inertia_kgm2 / params.radius_m;
+        cfg.gains.kp_nm_per_mps = kp as f32;
+        cfg.gains.ki_nm_per_m = (kp * crossover_radps / 4.0) as f32;
+        // The drum's own limits, not the reference reel's.
+        cfg.max_speed_mps = cfg.max_speed_mps.min(cfg.faults.max_encoder_rate_mps);
+        cfg
+    }
+
+    /// The drum `params` at rest (stuck, brake engaged), flown by a speed loop of `cfg`.
+    pub fn new(
+        params: DrumParams,
+        cfg: tss_reel::reel_drive::DriveConfig,
+    ) -> Result<Self, tss_reel::reel_drive::DriveConfigError> {
+        let speed = tss_reel::reel_drive::SpeedLoop::new(cfg)?;
+        let bits = cfg.geometry.encoder_bits;
+        Ok(Self {
+            params,
+            speed,
+            motion: Motion::Stuck,
+            rate_radps: 0.0,
+            angle_counts: 0.0,
+            counts_per_rad: f64::from(cfg.geometry.counts_per_drum_rev()) / std::f64::consts::TAU,
+            encoder_mask: if bits >= 32 {
+                u32::MAX
+            } else {
+                (1 << bits) - 1
+            },
+            torque_per_duty_nm: f64::from(cfg.max_torque_nm),
+            tick: 0,
+            substeps: 4,
+            figures: DriveFigures {
+                tension_range_n: (f64::INFINITY, f64::NEG_INFINITY),
+                ..DriveFigures::default()
+            },
+        })
+    }
+
+    /// Drum surface speed, m/s.
+    pub fn speed_mps(&self) -> f64 {
+        self.rate_radps * self.params.radius_m
+    }
+
+    /// The figures so far.
+    pub fn figures(&self) -> &DriveFigures {
+        &self.figures
+    }
+
+    /// The speed loop (its odometer, brake, last output).
+    pub fn speed_loop(&self) -> &tss_reel::reel_drive::SpeedLoop {
+        &self.speed
+    }
+
+    /// One law period of `ticks` inner ticks under the law's `command`, the tether pulling
+    /// with `tension_n` at the reel. Returns the drum's surface speed at its end, m/s, and the
+    /// period's largest |drum speed − reference| with the brake released, m/s.
+    pub fn period(
+        &mut self,
+        command: tss_reel::reel_drive::RateCommand,
+        tension_n: f64,
+        ticks: u32,
+    ) -> (f64, f64) {
+        use tss_reel::reel_drive::DriveInput;
+        let mut period_max_mps: f64 = 0.0;
+        let _ = self.speed.set_command(command, self.tick);
+        let dt = 1.0 / f64::from(self.speed.config().inner_rate_hz);
+        let h = dt / f64::from(self.substeps);
+        let f = &mut self.figures;
+        f.tension_range_n.0 = f.tension_range_n.0.min(tension_n);
+        f.tension_range_n.1 = f.tension_range_n.1.max(tension_n);
+        for _ in 0..ticks {
+            let raw = (self.angle_counts.floor() as i64 as u32) & self.encoder_mask;
+            let out = *self.speed.step(&DriveInput {
+                tick: self.tick,
+                encoder_count: Some(raw),
+                tension_n: Some(tension_n as f32),
+            });
+            let brake = !out.brake.brake_released();
+            let motor_nm = (f64::from(out.duty) * self.torque_per_duty_nm)
+                .clamp(-self.params.max_torque_nm, self.params.max_torque_nm);
+            let drive_nm = motor_nm + self.params.radius_m * tension_n;
+            for _ in 0..self.substeps {
+                let p = &self.params;
+                self.motion = p.motion_for_step(self.motion, drive_nm, self.rate_radps, brake);
+                let start = self.rate_radps;
+                let end = start + h * p.accel_radps2(self.motion, drive_nm, start, brake);
+                let (motion, rate) = p.after_step(self.motion, start, end, drive_nm, brake);
+                self.angle_counts += 0.5 * (start + rate) * h * self.counts_per_rad;
+                self.motion = motion;
+                self.rate_radps = rate;
+            }
+            let f = &mut self.figures;
+            f.ticks += 1;
+            f.saturated_ticks += u64::from(out.saturated);
+            f.fault_bits |= out.faults.bits();
+            if matches!(out.brake, tss_reel::reel_drive::Brake::Released { .. }) {
+                let error = self.rate_radps * self.params.radius_m - f64::from(out.ref_rate_mps);
+                f.released_ticks += 1;
+                f.sum_sq_error += error * error;
+                f.max_error_mps = f.max_error_mps.max(error.abs());
+                period_max_mps = period_max_mps.max(error.abs());
+            }
+            self.tick = self.tick.wrapping_add(1);
+        }
+        let end_error = (self.speed_mps() - f64::from(command.rate_mps)).abs();
+        let f = &mut self.figures;
+        f.max_period_end_error_mps = f.max_period_end_error_mps.max(end_error);
+        (self.speed_mps(), period_max_mps)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -106,6 +106,7 @@ impl Scenario {
             envelope: sc.envelope.to_envelope(),
             monitor: sc.monitor.to_monitor_config(),
             rate_source: sc.rate_source(),
+            protection: sc.protection.to_protection_config(),
         }
     }
 

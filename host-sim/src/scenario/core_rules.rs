@@ -121,6 +121,10 @@ fn message(sc: &Scenario, e: &ConfigError, key: &str, x: f64) -> String {
                 "must be above monitor.min_orbit_rate_radps = {}",
                 num(sc.monitor.min_orbit_rate_radps)
             ),
+            "protection.max_tension_n" => format!(
+                "must be above protection.min_tension_n = {}",
+                num(sc.protection.min_tension_n)
+            ),
             "stage1.band_start_m" => format!(
                 "must be below stage1.keep_length_m = {}",
                 num(sc.stage1.keep_length_m)
@@ -152,6 +156,14 @@ fn message(sc: &Scenario, e: &ConfigError, key: &str, x: f64) -> String {
             num(sc.masses.main_initial_kg)
         ),
         Rule::NoEquilibrium => "leaves no equilibrium over the whole orbit (Eq. 13)".to_string(),
+        Rule::BelowMinimum if key == "protection.tension_filter_s" => format!(
+            "must be at least controller.period_s = {} s",
+            num(sc.controller.period_s)
+        ),
+        Rule::TooLarge if key == "protection.max_tension_n" => format!(
+            "must be at most {} N (tss_reel::controller::MAX_PLAUSIBLE_TENSION_N)",
+            num(tss_reel::controller::MAX_PLAUSIBLE_TENSION_N)
+        ),
         Rule::BelowMinimum => format!(
             "must be at least {} s (tss_reel::config::MIN_PERIOD_S)",
             num(tss_reel::config::MIN_PERIOD_S)

@@ -6,7 +6,7 @@
 //! - one file per group of sections, each holding the section's schema (a serde struct, its
 //!   defaults) and its validation rules next to it: `system.rs` (`[orbit]`, `[masses]`,
 //!   `[tether]`), `initial.rs`, `control.rs` (`[controller]`, `[stage1]`, `[stage2]`),
-//!   `envelope.rs`, `monitor.rs`, `simulation.rs`, `sensors.rs` (`[sensors]`, `[faults]`),
+//!   `envelope.rs`, `monitor.rs`, `protection.rs`, `simulation.rs`, `sensors.rs` (`[sensors]`, `[faults]`),
 //!   `reel.rs`, `link.rs`, `montecarlo.rs`, `plant.rs` (`[plant]`), `environment.rs`;
 //! - `core_rules.rs`: the flight controller's own rules, not repeated here: the f32 controller
 //!   is built from the scenario and the parameter path of what it rejects is named by scenario
@@ -51,6 +51,7 @@ mod load;
 mod monitor;
 mod montecarlo;
 mod plant;
+mod protection;
 mod reel;
 mod rules;
 mod schema;
@@ -79,6 +80,7 @@ pub use montecarlo::{
     Distribution, MonteCarloSection,
 };
 pub use plant::{PlantModel, PlantSection, SensedDirection};
+pub use protection::ProtectionSection;
 pub use reel::{ReelModelName, ReelSection};
 pub use schema::{schema, LeafKind, Schema};
 pub use sensors::{
@@ -139,6 +141,10 @@ pub struct Scenario {
     /// Thresholds of the controller's sensor monitor (defaults: `MonitorConfig::default_for_period`).
     #[serde(default)]
     pub monitor: MonitorSection,
+    /// The controller's tension- and drive-aware protection (default: off, the paper's
+    /// controller).
+    #[serde(default)]
+    pub protection: ProtectionSection,
     /// Faults of the processor-in-the-loop serial link (`tss-sim run --pil`; default: none).
     /// A host-linked run has no link and ignores it.
     #[serde(default)]

@@ -477,6 +477,12 @@ fn every_rule_names_file_field_and_value() {
         (&["monitor.length_jump_m=0"], "monitor.length_jump_m", "0", "must be above 0"),
         (&["monitor.max_orbit_rate_radps=-1"], "monitor.max_orbit_rate_radps", "-1", "must be above monitor.min_orbit_rate_radps"),
         (&["monitor.max_orbit_rate_radps=1e-6"], "monitor.max_orbit_rate_radps", "0.000001", "must be above monitor.min_orbit_rate_radps = 0.00001"),
+        (&["protection.enabled=true", "protection.min_tension_n=-1"], "protection.min_tension_n", "-1", "must not be negative"),
+        (&["protection.enabled=true", "protection.max_tension_n=0.001"], "protection.max_tension_n", "0.001", "must be above protection.min_tension_n = 0.002"),
+        (&["protection.enabled=true", "protection.max_tension_n=1e6"], "protection.max_tension_n", "1000000", "must be at most 100000 N"),
+        (&["protection.enabled=true", "protection.tension_filter_s=0.5"], "protection.tension_filter_s", "0.5", "must be at least controller.period_s = 1 s"),
+        (&["protection.enabled=true", "protection.tension_filter_s=nan"], "protection.tension_filter_s", "NaN", "finite"),
+        (&["protection.enabled=true", "protection.drive_lag_s=-2"], "protection.drive_lag_s", "-2", "must not be negative"),
     ];
     for (sets, field, value, message) in cases {
         let e = err(sets);
