@@ -17,6 +17,9 @@ use tss_reel::controller::{Envelope, Fault, Flags, Health, Output};
 use tss_reel::Real;
 
 use crate::reel::ReelDrive;
+use crate::sensors::{
+    EncoderModel, LoadCell, LoadCellModel, RateSensor, ReelEncoder, SwingSensor, SwingSensorModel,
+};
 
 // ---- a small deterministic generator ---------------------------------------------------------
 
@@ -111,6 +114,10 @@ pub enum SensedQuantity {
     AlphaRate,
     /// The orbit rate θ̇, rad/s.
     OrbitRate,
+    /// The reel's rate from the encoder, m/s.
+    ReelRate,
+    /// The tension from the load cell, N.
+    Tension,
 }
 
 impl SensedQuantity {
@@ -121,6 +128,8 @@ impl SensedQuantity {
             Self::Alpha => "alpha",
             Self::AlphaRate => "alpha_rate",
             Self::OrbitRate => "orbit_rate",
+            Self::ReelRate => "reel_rate",
+            Self::Tension => "tension",
         }
     }
 }
@@ -167,12 +176,16 @@ pub struct Glitch {
 pub struct InjectionPlan {
     /// Seed of the noise generators (one stream per sensor).
     pub seed: u64,
-    /// The length encoder's errors.
-    pub length: SensorErrors,
-    /// The α sensor's errors.
-    pub alpha: SensorErrors,
+    /// The reel encoder (length and rate).
+    pub length: EncoderModel,
+    /// The swing sensor (α): errors, latency, α dropouts.
+    pub alpha: SwingSensorModel,
+    /// The α̇ sensor is fitted.
+    pub alpha_rate_enabled: bool,
     /// The α̇ sensor's errors.
     pub alpha_rate: SensorErrors,
+    /// The load cell.
+    pub load_cell: LoadCellModel,
     /// Windows without a sample (the controller's `step_missing`).
     pub dropout: Vec<Window>,
     /// Corrupted readings.
@@ -182,11 +195,14 @@ pub struct InjectionPlan {
 }
 
 impl InjectionPlan {
-    /// `true` if nothing is injected: the controller reads the truth (rounded to its type).
+    /// `true` if nothing is injected: the controller reads the truth (rounded to its type),
+    /// α̇ included.
     pub fn is_transparent(&self) -> bool {
         self.length.is_perfect()
             && self.alpha.is_perfect()
+            && self.alpha_rate_enabled
             && self.alpha_rate.is_perfect()
+            && self.load_cell.is_perfect()
             && self.dropout.is_empty()
             && self.corrupt.is_empty()
             && self.length_glitch.is_empty()
@@ -200,9 +216,9 @@ impl InjectionPlan {
 pub struct Truth {
     /// Tether length, m.
     pub length_m: f64,
-    /// The drum's actual rate over the last period (its length change over the period), m/s.
+    /// The drum's actual rate over the last period, m/s.
     pub reel_rate_mps: f64,
-    /// Tension at the reel at the end of the last period, under the command held over it, N.
+    /// Tension at the reel at the end of the last period (under the command held over it), N.
     pub tension_n: f64,
     /// α, rad.
     pub alpha_rad: f64,
@@ -214,19 +230,18 @@ pub struct Truth {
     pub true_anomaly_rad: f64,
 }
 
-/// What the controller reads at one tick: the fields of its `Input`, in f64, with the same
-/// options (`None`: that sensor gave nothing this period).
+/// What the controller reads at one tick: the `Input` fields in f64, with the same options.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Reading {
     /// Length from the reel encoder, m.
     pub length_m: f64,
-    /// The reel's rate from its encoder, m/s.
+    /// The reel's rate from the encoder, m/s (`None`: not measured this period).
     pub reel_rate_mps: Option<f64>,
-    /// Tension at the reel from the load cell, N.
+    /// Tension from the load cell, N (`None`: no load cell).
     pub tension_n: Option<f64>,
-    /// α from the swing sensor, rad.
+    /// α from the swing sensor, rad (`None`: it gave nothing this period).
     pub alpha_rad: Option<f64>,
-    /// α̇ from the optional rate sensor, rad/s.
+    /// α̇ from the rate sensor, rad/s (`None`: none fitted).
     pub alpha_rate_radps: Option<f64>,
     /// Orbit rate θ̇, rad/s.
     pub orbit_rate_radps: f64,
@@ -236,14 +251,14 @@ pub struct Reading {
 
 /// One sensor: bias, noise, quantisation, stuck window.
 #[derive(Clone, Debug)]
-struct Channel {
+pub(crate) struct Channel {
     cfg: SensorErrors,
     rng: Pcg32,
     held: Option<f64>,
 }
 
 impl Channel {
-    fn new(cfg: &SensorErrors, seed: u64, stream: u64) -> Self {
+    pub(crate) fn new(cfg: &SensorErrors, seed: u64, stream: u64) -> Self {
         Self {
             cfg: cfg.clone(),
             rng: Pcg32::new(seed, stream),
@@ -251,7 +266,7 @@ impl Channel {
         }
     }
 
-    fn read(&mut self, truth: f64, t_s: f64) -> f64 {
+    pub(crate) fn read(&mut self, truth: f64, t_s: f64) -> f64 {
         let c = &self.cfg;
         // Drawn every tick, used or not, so that the noise sequence is tied to time.
         let noise = if c.noise_std > 0.0 {
@@ -281,19 +296,30 @@ impl Channel {
 /// What the controller receives at one tick: a reading of every sensor, or nothing (dropout).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Sensed {
-    /// A sample (possibly wrong: noisy, biased, stuck, corrupted, glitched).
+    /// A sample (possibly wrong: noisy, biased, stuck, corrupted, glitched, or without α).
     Sample(Reading),
     /// No sample arrived (a `[[faults.dropout]]` window).
     Missing,
 }
 
+/// The noise streams of the sensors (`Pcg32` streams of `sensors.seed`): fixed, so that a
+/// sensor's noise does not depend on which other sensors are modelled.
+mod stream {
+    pub const LENGTH: u64 = 1;
+    pub const ALPHA: u64 = 2;
+    pub const ALPHA_RATE: u64 = 3;
+    pub const ALPHA_DROPOUT: u64 = 4;
+    pub const LOAD_CELL: u64 = 5;
+}
+
 /// Applies an [`InjectionPlan`] (a scenario's `[sensors]` and `[faults]`) to the plant's truth,
-/// tick by tick.
+/// tick by tick: the sensor models of [`crate::sensors`], then the injected faults.
 #[derive(Clone, Debug)]
 pub struct Injector {
-    length: Channel,
-    alpha: Channel,
-    alpha_rate: Channel,
+    encoder: ReelEncoder,
+    swing: SwingSensor,
+    rate: RateSensor,
+    load_cell: LoadCell,
     dropout: Vec<Window>,
     corrupt: Vec<Corruption>,
     /// (tick, size) of each length glitch.
@@ -303,10 +329,17 @@ pub struct Injector {
 impl Injector {
     /// The injector of `plan` on control period `period_s`.
     pub fn new(plan: &InjectionPlan, period_s: f64) -> Self {
+        let seed = plan.seed;
         Self {
-            length: Channel::new(&plan.length, plan.seed, 1),
-            alpha: Channel::new(&plan.alpha, plan.seed, 2),
-            alpha_rate: Channel::new(&plan.alpha_rate, plan.seed, 3),
+            encoder: ReelEncoder::new(&plan.length, period_s, seed, stream::LENGTH),
+            swing: SwingSensor::new(&plan.alpha, seed, stream::ALPHA, stream::ALPHA_DROPOUT),
+            rate: RateSensor::new(
+                plan.alpha_rate_enabled,
+                &plan.alpha_rate,
+                seed,
+                stream::ALPHA_RATE,
+            ),
+            load_cell: LoadCell::new(&plan.load_cell, seed, stream::LOAD_CELL),
             dropout: plan.dropout.clone(),
             corrupt: plan.corrupt.clone(),
             glitches: plan
@@ -317,14 +350,16 @@ impl Injector {
         }
     }
 
-    /// What the controller reads at `tick` (mission time `t_s`).
+    /// What the controller reads at `tick` (mission time `t_s`). Every sensor measures every
+    /// tick, a dropout's included (its noise stays tied to time).
     pub fn sense(&mut self, tick: u32, t_s: f64, truth: &Truth) -> Sensed {
+        let encoder = self.encoder.read(truth.length_m, truth.reel_rate_mps, t_s);
         let mut r = Reading {
-            length_m: self.length.read(truth.length_m, t_s),
-            reel_rate_mps: Some(truth.reel_rate_mps),
-            tension_n: Some(truth.tension_n),
-            alpha_rad: Some(self.alpha.read(truth.alpha_rad, t_s)),
-            alpha_rate_radps: Some(self.alpha_rate.read(truth.alpha_rate_radps, t_s)),
+            length_m: encoder.length_m,
+            reel_rate_mps: encoder.rate_mps,
+            tension_n: self.load_cell.read(truth.tension_n, t_s),
+            alpha_rad: self.swing.read(truth.alpha_rad, t_s),
+            alpha_rate_radps: self.rate.read(truth.alpha_rate_radps, t_s),
             orbit_rate_radps: truth.orbit_rate_radps,
             true_anomaly_rad: truth.true_anomaly_rad,
         };
@@ -343,6 +378,8 @@ impl Injector {
                     SensedQuantity::Alpha => r.alpha_rad = Some(c.value),
                     SensedQuantity::AlphaRate => r.alpha_rate_radps = Some(c.value),
                     SensedQuantity::OrbitRate => r.orbit_rate_radps = c.value,
+                    SensedQuantity::ReelRate => r.reel_rate_mps = Some(c.value),
+                    SensedQuantity::Tension => r.tension_n = Some(c.value),
                 }
             }
         }
@@ -765,9 +802,10 @@ pub fn injected_faults(setup: &FaultSetup) -> Vec<String> {
     let mut v = Vec::new();
     let plan = &setup.injection;
     for (name, c) in [
-        ("length (m)", &plan.length),
-        ("alpha (rad)", &plan.alpha),
+        ("length (m)", &plan.length.errors),
+        ("alpha (rad)", &plan.alpha.errors),
         ("alpha_rate (rad/s)", &plan.alpha_rate),
+        ("tension (N)", &plan.load_cell.errors),
     ] {
         let mut parts = Vec::new();
         if c.noise_std > 0.0 {
@@ -786,8 +824,38 @@ pub fn injected_faults(setup: &FaultSetup) -> Vec<String> {
             v.push(format!("sensor {name}: {}", parts.join(", ")));
         }
     }
-    if v.iter().any(|l| l.contains("noise")) {
+    if v.iter().any(|l| l.contains("noise")) || plan.alpha.dropout_prob > 0.0 {
         v.push(format!("noise seed {}", plan.seed));
+    }
+    if let Some(q) = plan.length.count_m() {
+        v.push(format!(
+            "reel encoder: {} counts per revolution of a {} m drum ({:.4e} m per count)",
+            plan.length.counts_per_rev, plan.length.drum_radius_m, q
+        ));
+    }
+    let a = &plan.alpha;
+    if a.latency_periods > 0 {
+        v.push(format!(
+            "swing sensor latency: {} periods",
+            a.latency_periods
+        ));
+    }
+    if a.dropout_prob > 0.0 {
+        v.push(format!(
+            "swing sensor: no α with probability {}",
+            a.dropout_prob
+        ));
+    }
+    for w in &a.dropout {
+        v.push(format!("no α {}", window(w.from_s, w.until_s)));
+    }
+    if !plan.load_cell.enabled {
+        v.push("no load cell".to_string());
+    } else if plan.load_cell.full_scale_n < f64::INFINITY {
+        v.push(format!(
+            "load cell full scale {} N",
+            plan.load_cell.full_scale_n
+        ));
     }
     for w in &plan.dropout {
         v.push(format!(
@@ -1024,6 +1092,129 @@ mod tests {
             / f64::from(n))
         .sqrt();
         assert!((rms - 0.01).abs() < 5e-4, "{rms}");
+    }
+
+    fn truth(t_s: f64) -> Truth {
+        Truth {
+            length_m: 100.0 + 2.0 * t_s,
+            reel_rate_mps: 2.0,
+            tension_n: 0.5,
+            alpha_rad: -0.7,
+            alpha_rate_radps: 1e-4,
+            orbit_rate_radps: 1.06e-3,
+            true_anomaly_rad: 1.06e-3 * t_s,
+        }
+    }
+
+    fn sample(s: Sensed) -> Reading {
+        match s {
+            Sensed::Sample(r) => r,
+            Sensed::Missing => panic!("no sample"),
+        }
+    }
+
+    #[test]
+    fn by_default_every_sensor_but_the_rate_sensor_reads_the_truth() {
+        let mut inj = Injector::new(&InjectionPlan::default(), 1.0);
+        let t = truth(3.0);
+        assert_eq!(
+            sample(inj.sense(3, 3.0, &t)),
+            Reading {
+                length_m: t.length_m,
+                reel_rate_mps: Some(2.0),
+                tension_n: Some(0.5),
+                alpha_rad: Some(-0.7),
+                alpha_rate_radps: None,
+                orbit_rate_radps: t.orbit_rate_radps,
+                true_anomaly_rad: t.true_anomaly_rad,
+            }
+        );
+        let mut ideal = Injector::new(
+            &InjectionPlan {
+                alpha_rate_enabled: true,
+                ..InjectionPlan::default()
+            },
+            1.0,
+        );
+        assert_eq!(sample(ideal.sense(3, 3.0, &t)).alpha_rate_radps, Some(1e-4));
+    }
+
+    #[test]
+    fn an_alpha_dropout_keeps_the_sample_and_a_sample_dropout_loses_it() {
+        let window = Window {
+            from_s: 10.0,
+            until_s: 12.0,
+        };
+        let mut inj = Injector::new(
+            &InjectionPlan {
+                alpha: SwingSensorModel {
+                    dropout: vec![window],
+                    ..SwingSensorModel::default()
+                },
+                dropout: vec![Window {
+                    from_s: 20.0,
+                    until_s: 21.0,
+                }],
+                ..InjectionPlan::default()
+            },
+            1.0,
+        );
+        for k in 0..25 {
+            let t_s = f64::from(k);
+            let s = inj.sense(k, t_s, &truth(t_s));
+            match k {
+                10 | 11 => {
+                    let r = sample(s);
+                    assert_eq!(r.alpha_rad, None);
+                    assert_eq!(r.length_m, truth(t_s).length_m);
+                }
+                20 => assert_eq!(s, Sensed::Missing),
+                _ => assert_eq!(sample(s).alpha_rad, Some(-0.7)),
+            }
+        }
+    }
+
+    #[test]
+    fn the_encoder_s_rate_is_its_count_difference_and_corruptions_reach_every_reading() {
+        let mut inj = Injector::new(
+            &InjectionPlan {
+                length: EncoderModel {
+                    counts_per_rev: 1000,
+                    drum_radius_m: 0.1,
+                    ..EncoderModel::default()
+                },
+                corrupt: vec![
+                    Corruption {
+                        sensor: SensedQuantity::Tension,
+                        window: Window {
+                            from_s: 2.0,
+                            until_s: 3.0,
+                        },
+                        value: f64::NAN,
+                    },
+                    Corruption {
+                        sensor: SensedQuantity::ReelRate,
+                        window: Window {
+                            from_s: 2.0,
+                            until_s: 3.0,
+                        },
+                        value: 99.0,
+                    },
+                ],
+                ..InjectionPlan::default()
+            },
+            1.0,
+        );
+        let q = std::f64::consts::TAU * 0.1 / 1000.0;
+        let first = sample(inj.sense(0, 0.0, &truth(0.0)));
+        assert_eq!(first.reel_rate_mps, None);
+        assert_eq!(first.length_m, (100.0 / q).floor() * q);
+        let second = sample(inj.sense(1, 1.0, &truth(1.0)));
+        let counts = (102.0 / q).floor() - (100.0 / q).floor();
+        assert_eq!(second.reel_rate_mps, Some(counts * q));
+        let third = sample(inj.sense(2, 2.0, &truth(2.0)));
+        assert!(third.tension_n.is_some_and(f64::is_nan));
+        assert_eq!(third.reel_rate_mps, Some(99.0));
     }
 
     #[test]

@@ -17,6 +17,7 @@ pub mod reel;
 pub mod report;
 pub mod run_cmd;
 pub mod scenario;
+pub mod sensors;
 pub mod sim;
 pub mod table1;
 pub mod usage;

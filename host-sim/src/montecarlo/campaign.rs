@@ -2,6 +2,9 @@
 
 use rayon::prelude::*;
 
+use tss_reel::controller::{Controller, Flags};
+
+use super::consistency::{ConsistencySums, RunConsistency, Watched};
 use crate::faults::Pcg32;
 use crate::history::History;
 use crate::report::summarize;
@@ -69,11 +72,19 @@ pub enum Metric {
     FaultTicks,
     /// Time in safe hold, s.
     SafeHold,
+    /// Largest |α the law flew − true α| from [`SETTLED_S`] on, rad (sampled, at the steps the
+    /// law ran: not while the controller coasts or holds): the estimate's error on the
+    /// estimator, the sensor's on the α̇ sensor (α_r + δ of the output).
+    AlphaError,
 }
+
+/// The law's α error counts from here, s: 30 min, after the release transient and the
+/// estimator's prior.
+pub const SETTLED_S: f64 = 1_800.0;
 
 impl Metric {
     /// Every metric, in `runs.csv` column order.
-    pub const ALL: [Metric; 13] = [
+    pub const ALL: [Metric; 14] = [
         Metric::TimeToKeep1,
         Metric::Overshoot,
         Metric::Keep1Error,
@@ -87,6 +98,7 @@ impl Metric {
         Metric::Faults,
         Metric::FaultTicks,
         Metric::SafeHold,
+        Metric::AlphaError,
     ];
 
     /// The column name in `runs.csv`.
@@ -105,6 +117,7 @@ impl Metric {
             Metric::Faults => "faults",
             Metric::FaultTicks => "fault_ticks",
             Metric::SafeHold => "safe_hold_s",
+            Metric::AlphaError => "alpha_error_rad",
         }
     }
 
@@ -124,6 +137,7 @@ impl Metric {
             Metric::Faults => "distinct faults raised",
             Metric::FaultTicks => "ticks with a fault",
             Metric::SafeHold => "time in safe hold (s)",
+            Metric::AlphaError => "max |α flown − α| after 30 min (rad)",
         }
     }
 }
@@ -284,6 +298,18 @@ impl Outcome {
             Some(f.faults.iter().map(|t| u64::from(t.ticks)).sum::<u64>() as f64),
         );
         set(Metric::SafeHold, Some(f.safe_hold_s));
+        let alpha_error = h
+            .samples
+            .iter()
+            .filter(|x| x.t_s >= SETTLED_S && x.flags & Flags::SAFE_ACTION == 0)
+            .map(|x| (x.alpha_ref_rad + x.delta_rad - x.alpha_rad).abs())
+            .fold(None, |m: Option<f64>, e| {
+                Some(match m {
+                    Some(m) if m.is_nan() || m >= e => m,
+                    _ => e,
+                })
+            });
+        set(Metric::AlphaError, alpha_error);
         let worst_health = if f.safe_hold_s > 0.0 {
             WorstHealth::SafeHold
         } else if f.degraded_s > 0.0 {
@@ -471,11 +497,32 @@ impl Campaign {
 
     /// Flies run `index` and judges it.
     pub fn run(&self, index: u64) -> RunRecord {
+        self.fly(index, false).0
+    }
+
+    /// Flies run `index` and judges it; with `watch`, the flight filter flies beside the
+    /// controller and the run's NEES and NIS come back too (`None` if the run did not
+    /// complete).
+    pub fn fly(&self, index: u64, watch: bool) -> (RunRecord, Option<RunConsistency>) {
         let inputs = self.draw(index);
         let sensor_seed = run_seed(self.seed, index, SENSOR_STREAM);
+        let mut consistency = None;
         let result = self.scenario_for(index, &inputs).and_then(|sc| {
             let probes = probe_times_for(&sc);
-            crate::sim::run(&sc, &probes, &mut |_| {})
+            let history = if watch {
+                let mut ctl = crate::sim::controller_config::<f32>(&sc)
+                    .and_then(|c| Controller::new(c).map_err(crate::sim::SimError::Config))
+                    .map_err(|e| e.to_string())?;
+                let mut watched = Watched::new(&sc, &mut ctl).map_err(|e| e.to_string())?;
+                let h = crate::sim::run_stepper(&sc, &mut watched, &probes, &mut |_| {});
+                if let Ok(h) = &h {
+                    consistency = Some(watched.finish(h, sc.controller.period_s));
+                }
+                h
+            } else {
+                crate::sim::run(&sc, &probes, &mut |_| {})
+            };
+            history
                 .map(|h| Outcome::of(&sc, &h))
                 .map_err(|e| e.to_string())
         });
@@ -486,14 +533,15 @@ impl Campaign {
             }
             Err(e) => (None, vec![Criterion::Completed], e),
         };
-        RunRecord {
+        let record = RunRecord {
             run: index,
             sensor_seed,
             inputs,
             outcome,
             failed,
             error,
-        }
+        };
+        (record, consistency)
     }
 
     /// Flies the runs `indices` on `threads` threads (0: one per core), calling `done` after
@@ -504,22 +552,41 @@ impl Campaign {
         threads: usize,
         done: &(dyn Fn() + Sync),
     ) -> anyhow::Result<Vec<RunRecord>> {
+        Ok(self.run_all_watched(indices, threads, false, done)?.0)
+    }
+
+    /// [`Campaign::run_all`], with `watch` the estimator's consistency summed over the runs
+    /// (in run order, so the sums do not depend on the thread count).
+    pub fn run_all_watched(
+        &self,
+        indices: &[u64],
+        threads: usize,
+        watch: bool,
+        done: &(dyn Fn() + Sync),
+    ) -> anyhow::Result<(Vec<RunRecord>, Option<ConsistencySums>)> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .map_err(|e| anyhow::anyhow!("cannot start {threads} threads: {e}"))?;
-        let mut records: Vec<RunRecord> = pool.install(|| {
+        let mut flown: Vec<(RunRecord, Option<RunConsistency>)> = pool.install(|| {
             indices
                 .par_iter()
                 .map(|&i| {
-                    let r = self.run(i);
+                    let r = self.fly(i, watch);
                     done();
                     r
                 })
                 .collect()
         });
-        records.sort_by_key(|r| r.run);
-        Ok(records)
+        flown.sort_by_key(|(r, _)| r.run);
+        let sums = watch.then(|| {
+            let mut sums = ConsistencySums::default();
+            for c in flown.iter().filter_map(|(_, c)| c.as_ref()) {
+                sums.add(c);
+            }
+            sums
+        });
+        Ok((flown.into_iter().map(|(r, _)| r).collect(), sums))
     }
 }
 

@@ -17,9 +17,11 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize};
 
 use super::campaign::{Campaign, RunRecord};
+use super::consistency::{self, ConsistencyFigure, ConsistencySums};
 use super::stats::{render, CampaignInfo, Shard};
 use super::{plots, table};
 use crate::output::{check_output_dir, OutputSet};
+use crate::plots::{png_and_svg, write_png_and_svg};
 use crate::scenario::Scenario;
 use crate::usage::{quiet, UsageError};
 
@@ -55,6 +57,11 @@ pub struct MonteCarloArgs {
     /// Do not draw the figures (e.g. for shards: `merge` draws them).
     #[arg(long)]
     pub no_figures: bool,
+    /// Fly the flight estimator beside each run's controller and judge its consistency:
+    /// NEES and NIS averaged over the runs against their 95 % χ² bands (`consistency.csv`,
+    /// `consistency.txt` and a figure; a shard's are its runs' alone).
+    #[arg(long)]
+    pub consistency: bool,
     /// Override one scenario field, dotted key and TOML value, e.g.
     /// `--set simulation.duration_s=3600` (repeatable; applied in order).
     #[arg(long = "set", short = 's', value_name = "KEY=VALUE")]
@@ -132,13 +139,25 @@ pub const SUMMARY_TXT: &str = "summary.txt";
 pub const CAMPAIGN_TOML: &str = "campaign.toml";
 /// The scenario as loaded.
 pub const SCENARIO_TOML: &str = "scenario.toml";
+/// The estimator's consistency per instant (`--consistency`).
+pub const CONSISTENCY_CSV: &str = "consistency.csv";
+/// The estimator's consistency summary (`--consistency`).
+pub const CONSISTENCY_TXT: &str = "consistency.txt";
 
 /// Every file `montecarlo` and `merge` may write into their output directory.
 pub fn output_names() -> Vec<String> {
-    let mut names: Vec<String> = [RUNS_CSV, SUMMARY_TXT, CAMPAIGN_TOML, SCENARIO_TOML]
-        .map(String::from)
-        .to_vec();
+    let mut names: Vec<String> = [
+        RUNS_CSV,
+        SUMMARY_TXT,
+        CAMPAIGN_TOML,
+        SCENARIO_TOML,
+        CONSISTENCY_CSV,
+        CONSISTENCY_TXT,
+    ]
+    .map(String::from)
+    .to_vec();
     names.extend(plots::figure_names());
+    names.extend(png_and_svg(consistency::FIGURE_STEM));
     names
 }
 
@@ -197,9 +216,9 @@ pub fn montecarlo(args: &MonteCarloArgs) -> anyhow::Result<()> {
     } else {
         args.threads
     };
-    let records = campaign.run_all(&indices, threads, &|| bar.inc(1));
+    let flown = campaign.run_all_watched(&indices, threads, args.consistency, &|| bar.inc(1));
     bar.finish_and_clear();
-    let records = records?;
+    let (records, sums) = flown?;
     let elapsed = started.elapsed().as_secs_f64();
     let (report, figures) = write_outputs(
         &mut out,
@@ -209,9 +228,19 @@ pub fn montecarlo(args: &MonteCarloArgs) -> anyhow::Result<()> {
         &records,
         !args.no_figures,
     )?;
+    let consistency = match &sums {
+        Some(sums) => write_consistency(
+            &mut out,
+            &campaign.scenario,
+            sums,
+            records.len(),
+            !args.no_figures,
+        )?,
+        None => String::new(),
+    };
     out.commit()?;
     if !quiet() {
-        print!("{report}");
+        print!("{report}{consistency}");
         println!(
             "\nFlew {} runs in {elapsed:.2} s on {threads} thread(s) ({:.1} ms per run per \
              thread); outputs in {}",
@@ -283,6 +312,32 @@ fn write_outputs(
         Ok(())
     };
     Ok((summary, figures))
+}
+
+/// Writes the estimator's consistency (`consistency.csv`, `consistency.txt` and, if
+/// `draw_figure`, its figure) into `out`; returns the summary text.
+fn write_consistency(
+    out: &mut OutputSet,
+    sc: &Scenario,
+    sums: &ConsistencySums,
+    runs: usize,
+    draw_figure: bool,
+) -> anyhow::Result<String> {
+    out.write(CONSISTENCY_CSV, |w| sums.write_csv(w))?;
+    let text = sums.summary().render(runs);
+    out.write(CONSISTENCY_TXT, |w| w.write_all(text.as_bytes()))?;
+    if draw_figure {
+        crate::plots::check_font()?;
+        let figure = ConsistencyFigure {
+            sums,
+            title: format!(
+                "Estimator consistency over {runs} runs of `{}` (dashed: 95 % bands)",
+                sc.name
+            ),
+        };
+        write_png_and_svg(out, consistency::FIGURE_STEM, (1200, 1200), &figure)?;
+    }
+    Ok(text)
 }
 
 /// One shard directory, read and checked.

@@ -28,6 +28,7 @@
 
 pub mod campaign;
 pub mod cmd;
+pub mod consistency;
 pub mod plots;
 pub mod stats;
 pub mod table;

@@ -12,6 +12,8 @@ use tss_reel::orbit::Orbit;
 use tss_reel::schedule::BandSchedule;
 use tss_reel::Real;
 
+use tss_reel::estimator;
+
 use crate::elastic::environment::Environment;
 use crate::elastic::reel_drum::DrumParams;
 use crate::elastic::tether::TetherParams;
@@ -20,13 +22,44 @@ use crate::faults::{
     Corruption, FaultSetup, Glitch, InjectionPlan, SensedQuantity, SensorErrors, Window,
 };
 use crate::reel::{Reel, ReelDrive};
+use crate::sensors::{EncoderModel, LoadCellModel, SwingSensorModel};
 
 use super::{
-    EnvelopeSection, MonitorSection, ReelModelName, ReelSection, Scenario, SensedDirection,
-    SensorName, SensorSection, WindowSection,
+    EncoderSection, EnvelopeSection, LoadCellSection, MonitorSection, RateSensorSection,
+    ReelModelName, ReelSection, Scenario, SensedDirection, SensorName, SwingSensorSection,
+    WindowSection,
 };
 
+/// The smallest α noise the estimator is told, rad (its `Config::validate` floor): an ideal
+/// swing sensor is flown as one this good.
+pub const MIN_ASSUMED_ALPHA_NOISE_RAD: f64 = 1e-6;
+
 impl Scenario {
+    /// The libration estimator's tuning for this scenario's swing sensor:
+    /// `estimator::Config::paper()` at the control period, told the sensor's noise (at least
+    /// the filter's floor of 1e-6 rad) and quantum. The filter then assumes what the sensor's
+    /// data sheet would say; its bias, latency and dropouts are the filter's to cope with.
+    pub fn estimator_config<T: Real>(&self) -> estimator::Config<T> {
+        let a = &self.sensors.alpha;
+        estimator::Config {
+            period_s: T::from_f64(self.controller.period_s),
+            alpha_noise_rad: T::from_f64(a.noise_std.max(MIN_ASSUMED_ALPHA_NOISE_RAD)),
+            alpha_quantum_rad: T::from_f64(a.quantum),
+            ..estimator::Config::paper()
+        }
+    }
+
+    /// Where the law's α̇ comes from: the α̇ sensor if the scenario fits one
+    /// (`sensors.alpha_rate.enabled`, the paper's idealisation), else the estimator on the
+    /// swing sensor's α ([`Scenario::estimator_config`]), as in flight.
+    pub fn rate_source<T: Real>(&self) -> RateSource<T> {
+        if self.sensors.alpha_rate.enabled {
+            RateSource::Sensor
+        } else {
+            RateSource::Estimator(self.estimator_config())
+        }
+    }
+
     /// The flight controller's configuration, in its scalar type `T` (f32 on the target): the
     /// numbers `Config::validate` judges. The stage-2 start is the nearest control tick.
     pub fn controller_config<T: Real>(&self) -> Config<T> {
@@ -72,7 +105,7 @@ impl Scenario {
             keep_capture_m: f(sc.controller.keep_capture_m),
             envelope: sc.envelope.to_envelope(),
             monitor: sc.monitor.to_monitor_config(),
-            rate_source: RateSource::Sensor,
+            rate_source: sc.rate_source(),
             protection: sc.protection.to_protection_config(),
         }
     }
@@ -107,18 +140,68 @@ impl MonitorSection {
     }
 }
 
-impl From<&SensorSection> for SensorErrors {
-    fn from(s: &SensorSection) -> Self {
+/// A sensor's bias, noise, quantum and stuck window (`stuck_from_s = inf`, the default, is
+/// never).
+fn errors(noise_std: f64, bias: f64, quantum: f64, stuck: (f64, f64)) -> SensorErrors {
+    SensorErrors {
+        noise_std,
+        bias,
+        quantum,
+        stuck: (stuck.0 != f64::INFINITY).then_some(Window {
+            from_s: stuck.0,
+            until_s: stuck.1,
+        }),
+    }
+}
+
+impl From<&EncoderSection> for EncoderModel {
+    fn from(s: &EncoderSection) -> Self {
         Self {
-            noise_std: s.noise_std,
-            bias: s.bias,
-            quantum: s.quantum,
-            // `stuck_from_s = inf` (the default) is never.
-            stuck: (s.stuck_from_s != f64::INFINITY).then_some(Window {
-                from_s: s.stuck_from_s,
-                until_s: s.stuck_until_s,
-            }),
+            errors: errors(
+                s.noise_std,
+                s.bias,
+                s.quantum,
+                (s.stuck_from_s, s.stuck_until_s),
+            ),
+            counts_per_rev: s.counts_per_rev,
+            drum_radius_m: s.drum_radius_m,
         }
+    }
+}
+
+impl From<&RateSensorSection> for SensorErrors {
+    fn from(s: &RateSensorSection) -> Self {
+        errors(
+            s.noise_std,
+            s.bias,
+            s.quantum,
+            (s.stuck_from_s, s.stuck_until_s),
+        )
+    }
+}
+
+impl From<&LoadCellSection> for LoadCellModel {
+    fn from(s: &LoadCellSection) -> Self {
+        Self {
+            enabled: s.enabled,
+            errors: errors(s.noise_std_n, s.bias_n, s.quantum_n, (f64::INFINITY, 0.0)),
+            full_scale_n: s.full_scale_n,
+        }
+    }
+}
+
+/// The swing sensor of `[sensors.alpha]` with the α dropouts of `[[faults.alpha_dropout]]`.
+fn swing_sensor(s: &SwingSensorSection, dropout: &[WindowSection]) -> SwingSensorModel {
+    SwingSensorModel {
+        errors: errors(
+            s.noise_std,
+            s.bias,
+            s.quantum,
+            (s.stuck_from_s, s.stuck_until_s),
+        ),
+        latency_periods: s.latency_periods,
+        dropout_prob: s.dropout_prob,
+        dropout: dropout.iter().map(Window::from).collect(),
     }
 }
 
@@ -129,6 +212,8 @@ impl From<SensorName> for SensedQuantity {
             SensorName::Alpha => Self::Alpha,
             SensorName::AlphaRate => Self::AlphaRate,
             SensorName::OrbitRate => Self::OrbitRate,
+            SensorName::ReelRate => Self::ReelRate,
+            SensorName::Tension => Self::Tension,
         }
     }
 }
@@ -149,8 +234,10 @@ impl From<&Scenario> for InjectionPlan {
         Self {
             seed: s.seed,
             length: (&s.length).into(),
-            alpha: (&s.alpha).into(),
+            alpha: swing_sensor(&s.alpha, &f.alpha_dropout),
+            alpha_rate_enabled: s.alpha_rate.enabled,
             alpha_rate: (&s.alpha_rate).into(),
+            load_cell: (&s.load_cell).into(),
             dropout: f.dropout.iter().map(Window::from).collect(),
             corrupt: f
                 .corrupt

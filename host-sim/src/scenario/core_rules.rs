@@ -42,6 +42,10 @@ fn scenario_key(sc: &Scenario, e: &ConfigError) -> String {
         "gains.k2_per_s2" => "controller.k2_per_s2",
         "keep_capture_m" => "controller.keep_capture_m",
         "initial_rate_mps" => "initial.length_rate_mps",
+        // The estimator is told the swing sensor's figures (`Scenario::estimator_config`).
+        "rate_source.estimator.alpha_noise_rad" => "sensors.alpha.noise_std",
+        "rate_source.estimator.alpha_quantum_rad" => "sensors.alpha.quantum",
+        "rate_source.estimator.period_s" => "controller.period_s",
         "masses.tether_density_kg_per_m" => "tether.density_kg_per_m",
         "stage1.schedule.low_angle_rad" => "stage1.deploy_angle_rad",
         "stage1.schedule.high_length_m" => "stage1.keep_length_m",
@@ -171,6 +175,12 @@ fn message(sc: &Scenario, e: &ConfigError, key: &str, x: f64) -> String {
             num(sc.controller.period_s),
             num(tss_reel::config::MAX_POLE_PERIOD_PRODUCT)
         ),
+        Rule::OutOfRange if key == "sensors.alpha.noise_std" || key == "sensors.alpha.quantum" => {
+            "is beyond what the controller's estimator can be tuned for (at most 0.5 rad: \
+             tss_reel::estimator::Config::validate); fit an α̇ sensor \
+             (sensors.alpha_rate.enabled = true) to fly without the estimator"
+                .to_string()
+        }
         Rule::TooLarge => "is so large that monitor.coast_ticks × monitor.good_samples_per_bad \
                            overflows a 32-bit count"
             .to_string(),

@@ -28,6 +28,10 @@ const BASE_FILE: &str = "paper.toml";
 pub const ARRAY_TEMPLATES: &[(&str, &str)] = &[
     ("faults.dropout", "{ from_s = 100.0, until_s = 200.0 }"),
     (
+        "faults.alpha_dropout",
+        "{ from_s = 100.0, until_s = 200.0 }",
+    ),
+    (
         "faults.corrupt",
         "{ sensor = \"alpha\", from_s = 100.0, until_s = 200.0, value = 0.0 }",
     ),
@@ -349,13 +353,14 @@ fn masked(message: &str) -> String {
 
 /// The names of the number keys that have no unit: ratios, coefficients and counts (the last
 /// part of the key; `tss-sim scenario keys` shows "-" for them).
-pub const DIMENSIONLESS_NAMES: [&str; 11] = [
+pub const DIMENSIONLESS_NAMES: [&str; 12] = [
     "eccentricity",
     "courant",
     "drag_coefficient",
     "seed",
     "substeps",
     "good_samples_per_bad",
+    "counts_per_rev",
     // The tension laws' gains (`[controller.rupp]`, `[controller.tracking]`): in units of Ω.
     "length_gain",
     "rate_gain",
@@ -387,6 +392,7 @@ pub fn unit_of(key: &str) -> &'static str {
         ("_m", "m"),
         ("_s", "s"),
         ("_ticks", "ticks"),
+        ("_periods", "control periods"),
         ("_prob", "probability"),
     ];
     let name = key.rsplit('.').next().unwrap_or(key);
@@ -396,6 +402,12 @@ pub fn unit_of(key: &str) -> &'static str {
     // A sensor's errors are in the sensor's unit; so is an injected corrupt value, and a
     // dispersion's parameters are in the unit of the field it disperses.
     match key.rsplit_once('.').map(|(section, _)| section) {
+        Some(section)
+            if !matches!(name, "noise_std" | "bias" | "quantum")
+                && section.starts_with("sensors.") =>
+        {
+            ""
+        }
         Some("sensors.length") => "m",
         Some("sensors.alpha") => "rad",
         Some("sensors.alpha_rate") => "rad/s",

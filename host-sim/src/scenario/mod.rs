@@ -84,8 +84,9 @@ pub use protection::ProtectionSection;
 pub use reel::{ReelModelName, ReelSection};
 pub use schema::{schema, LeafKind, Schema};
 pub use sensors::{
-    CorruptSection, FaultsSection, GlitchSection, SensorName, SensorSection, SensorsSection,
-    WindowSection, MAX_FAULT_ENTRIES,
+    CorruptSection, EncoderSection, FaultsSection, GlitchSection, LoadCellSection,
+    RateSensorSection, SensorName, SensorsSection, SwingSensorSection, WindowSection,
+    MAX_FAULT_ENTRIES,
 };
 pub use simulation::{
     SimulationSection, MAX_HISTORY_ROWS, MAX_PLANT_STEPS, MAX_SUBSTEPS, MAX_TICKS,

@@ -1,14 +1,19 @@
-//! `[sensors]` and `[faults]`: the errors and faults injected between the plant and the
-//! controller (`crate::faults::Injector` flies them; `convert` turns these sections into its
-//! parameters).
+//! `[sensors]` and `[faults]`: the sensors the controller reads through (their models and
+//! errors) and the faults injected between the plant and the controller
+//! (`crate::faults::Injector` flies them; `convert` turns these sections into its parameters).
+//!
+//! Every error defaults to zero: a section left out is an ideal sensor (the paper's
+//! idealisation, which `scenarios/paper.toml` flies), except that the α̇ rate sensor is off
+//! unless `sensors.alpha_rate.enabled = true` (no flight sensor measures α̇: issue 18).
+//! Realistic figures, and what each stands for, are in the README's sensor table and in
+//! `scenarios/paper-montecarlo.toml`.
 
 use serde::{Deserialize, Serialize};
 
-use super::rules::Validator;
+use super::rules::{num, Validator};
 
-/// `[sensors]`: what the controller reads is the plant's truth plus these errors, applied in the
-/// order bias, noise, quantisation, then a stuck window freezes the reading (then the sensed
-/// values are rounded to the controller's scalar type last). The noise is reproducible: one
+/// `[sensors]`: what the controller reads is the plant's truth through these models (see each
+/// section), then rounded to the controller's scalar type. The noise is reproducible: one
 /// seeded generator per sensor (see `faults::Pcg32`).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -16,29 +21,134 @@ pub struct SensorsSection {
     /// Seed of the noise generators (the same seed gives the same run, on any machine).
     #[serde(default)]
     pub seed: u64,
-    /// The length encoder (units: m).
+    /// The reel encoder: the paid-out length and the reel's rate (units: m).
     #[serde(default)]
-    pub length: SensorSection,
-    /// The in-plane angle sensor α (units: rad).
+    pub length: EncoderSection,
+    /// The swing sensor: the in-plane angle α (units: rad).
     #[serde(default)]
-    pub alpha: SensorSection,
-    /// The in-plane rate sensor α̇ (units: rad/s).
+    pub alpha: SwingSensorSection,
+    /// The optional in-plane rate sensor α̇ (units: rad/s; off by default).
     #[serde(default)]
-    pub alpha_rate: SensorSection,
+    pub alpha_rate: RateSensorSection,
+    /// The load cell at the reel: the tether's tension (units: N).
+    #[serde(default)]
+    pub load_cell: LoadCellSection,
 }
 
-/// `[sensors.length]`, `[sensors.alpha]`, `[sensors.alpha_rate]`: one sensor's errors, in the
-/// sensor's own unit (m, rad, rad/s).
+/// `[sensors.length]`: the reel encoder. The length the drum has paid out, plus bias and
+/// noise, rounded to `quantum` and frozen in a stuck window (as any sensor below), is counted
+/// in whole encoder counts of 2π·`drum_radius_m`/`counts_per_rev` (when `counts_per_rev` > 0);
+/// the reel's rate is the count difference over the period. With `counts_per_rev = 0` and no
+/// error the encoder reads the truth, length and rate.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct SensorSection {
-    /// Standard deviation of white Gaussian noise added every sample (0 = none).
+pub struct EncoderSection {
+    /// Standard deviation of white Gaussian noise added to the length every sample, m
+    /// (tether slip and stretch on the drum; 0 = none).
     #[serde(default)]
     pub noise_std: f64,
-    /// Constant offset added to every sample.
+    /// Constant offset of the length, m (the zero of the count).
     #[serde(default)]
     pub bias: f64,
-    /// Quantisation step: the reading is rounded to a multiple of it (0 = none).
+    /// Quantisation step of the length, m (0 = none; `counts_per_rev` is the encoder's own).
+    #[serde(default)]
+    pub quantum: f64,
+    /// The encoder repeats the count it gave at this time, s (inf = never).
+    #[serde(default = "infinity")]
+    pub stuck_from_s: f64,
+    /// … until this time, s (inf = to the end of the run).
+    #[serde(default = "infinity")]
+    pub stuck_until_s: f64,
+    /// Encoder counts per drum revolution (0: no counting, the length is continuous).
+    #[serde(default)]
+    pub counts_per_rev: u32,
+    /// Radius of the drum the tether leaves, m: one count is 2π·radius/counts_per_rev of tether.
+    #[serde(default = "drum_radius_m")]
+    pub drum_radius_m: f64,
+}
+
+impl Default for EncoderSection {
+    fn default() -> Self {
+        Self {
+            noise_std: 0.0,
+            bias: 0.0,
+            quantum: 0.0,
+            stuck_from_s: f64::INFINITY,
+            stuck_until_s: f64::INFINITY,
+            counts_per_rev: 0,
+            drum_radius_m: drum_radius_m(),
+        }
+    }
+}
+
+/// The default drum radius, m (a 20 cm drum, the size of a small deployer's spool).
+fn drum_radius_m() -> f64 {
+    0.1
+}
+
+/// `[sensors.alpha]`: the swing sensor (a deployer angle sensor or relative navigation). Each
+/// period it measures α + bias + noise, rounded to `quantum` (frozen in a stuck window); the
+/// controller receives the measurement of `latency_periods` periods ago, or nothing (an α
+/// dropout, `alpha_rad: None`: the estimator predicts only) with probability `dropout_prob`,
+/// in a `[[faults.alpha_dropout]]` window, and in the first `latency_periods` periods.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SwingSensorSection {
+    /// Standard deviation of white Gaussian noise added every sample, rad (0 = none).
+    #[serde(default)]
+    pub noise_std: f64,
+    /// Constant offset added to every sample, rad (misalignment).
+    #[serde(default)]
+    pub bias: f64,
+    /// Quantisation step, rad (0 = none).
+    #[serde(default)]
+    pub quantum: f64,
+    /// The sensor repeats the reading it gave at this time, s (inf = never).
+    #[serde(default = "infinity")]
+    pub stuck_from_s: f64,
+    /// … until this time, s (inf = to the end of the run).
+    #[serde(default = "infinity")]
+    pub stuck_until_s: f64,
+    /// Whole control periods between measuring α and the controller receiving it (0: the
+    /// reading is of this period).
+    #[serde(default)]
+    pub latency_periods: u16,
+    /// Probability that a period's α does not arrive (independent draws; 0 = never).
+    #[serde(default)]
+    pub dropout_prob: f64,
+}
+
+impl Default for SwingSensorSection {
+    fn default() -> Self {
+        Self {
+            noise_std: 0.0,
+            bias: 0.0,
+            quantum: 0.0,
+            stuck_from_s: f64::INFINITY,
+            stuck_until_s: f64::INFINITY,
+            latency_periods: 0,
+            dropout_prob: 0.0,
+        }
+    }
+}
+
+/// `[sensors.alpha_rate]`: an α̇ rate sensor, which no flight has carried: the paper's
+/// idealisation (Table 1), for comparison. Off unless `enabled`; then α̇ + bias + noise,
+/// rounded to `quantum`, frozen in a stuck window.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RateSensorSection {
+    /// The sensor is fitted and read (the controller then flies on it, the paper's law as
+    /// printed; without it the controller flies its estimator on α alone).
+    #[serde(default)]
+    pub enabled: bool,
+    /// Standard deviation of white Gaussian noise added every sample, rad/s (0 = none).
+    #[serde(default)]
+    pub noise_std: f64,
+    /// Constant offset added to every sample, rad/s.
+    #[serde(default)]
+    pub bias: f64,
+    /// Quantisation step, rad/s (0 = none).
     #[serde(default)]
     pub quantum: f64,
     /// The sensor repeats the reading it gave at this time, s (inf = never).
@@ -49,9 +159,10 @@ pub struct SensorSection {
     pub stuck_until_s: f64,
 }
 
-impl Default for SensorSection {
+impl Default for RateSensorSection {
     fn default() -> Self {
         Self {
+            enabled: false,
             noise_std: 0.0,
             bias: 0.0,
             quantum: 0.0,
@@ -61,6 +172,43 @@ impl Default for SensorSection {
     }
 }
 
+/// `[sensors.load_cell]`: the tension at the reel, T + bias + noise, rounded to `quantum_n`
+/// and held within ±`full_scale_n` (a load cell saturates at its full scale).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadCellSection {
+    /// The load cell is fitted and read (`false`: the controller gets no tension).
+    #[serde(default = "yes")]
+    pub enabled: bool,
+    /// Standard deviation of white Gaussian noise added every sample, N (0 = none).
+    #[serde(default)]
+    pub noise_std_n: f64,
+    /// Constant offset, N (the zero's drift).
+    #[serde(default)]
+    pub bias_n: f64,
+    /// Quantisation step, N (0 = none; the converter's resolution).
+    #[serde(default)]
+    pub quantum_n: f64,
+    /// The largest tension it reads, N: beyond ±full scale it reads ±full scale (inf = none).
+    #[serde(default = "infinity")]
+    pub full_scale_n: f64,
+}
+
+impl Default for LoadCellSection {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            noise_std_n: 0.0,
+            bias_n: 0.0,
+            quantum_n: 0.0,
+            full_scale_n: f64::INFINITY,
+        }
+    }
+}
+
+fn yes() -> bool {
+    true
+}
 /// `[faults]`: injected faults. Windows are half-open, [from_s, until_s), on the control ticks.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -68,6 +216,10 @@ pub struct FaultsSection {
     /// `[[faults.dropout]]`: no sample arrives (the controller's `step_missing`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub dropout: Vec<WindowSection>,
+    /// `[[faults.alpha_dropout]]`: the sample arrives without α (`alpha_rad: None`: the swing
+    /// sensor gave nothing; the estimator predicts only).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub alpha_dropout: Vec<WindowSection>,
     /// `[[faults.corrupt]]`: one sensor reads a fixed value (NaN, inf, anything).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub corrupt: Vec<CorruptSection>,
@@ -98,6 +250,10 @@ pub enum SensorName {
     AlphaRate,
     /// The orbit-rate source.
     OrbitRate,
+    /// The reel's rate from the encoder.
+    ReelRate,
+    /// The load cell.
+    Tension,
 }
 
 impl SensorName {
@@ -108,6 +264,8 @@ impl SensorName {
             Self::Alpha => "alpha",
             Self::AlphaRate => "alpha_rate",
             Self::OrbitRate => "orbit_rate",
+            Self::ReelRate => "reel_rate",
+            Self::Tension => "tension",
         }
     }
 }
@@ -142,29 +300,66 @@ fn infinity() -> f64 {
 }
 
 impl SensorsSection {
-    /// Finite errors; a stuck window that does not end before it starts.
+    /// Finite errors, non-negative deviations and quanta, stuck windows that do not end
+    /// before they start; a drum radius above 0 when the encoder counts; a probability in
+    /// [0, 1]; a full scale above 0.
     pub(super) fn check(&self, v: &mut Validator) {
-        for (name, sensor) in [
-            ("sensors.length", &self.length),
-            ("sensors.alpha", &self.alpha),
-            ("sensors.alpha_rate", &self.alpha_rate),
+        let (l, a, r) = (&self.length, &self.alpha, &self.alpha_rate);
+        for (name, noise_std, bias, quantum, (from, until)) in [
+            (
+                "sensors.length",
+                l.noise_std,
+                l.bias,
+                l.quantum,
+                (l.stuck_from_s, l.stuck_until_s),
+            ),
+            (
+                "sensors.alpha",
+                a.noise_std,
+                a.bias,
+                a.quantum,
+                (a.stuck_from_s, a.stuck_until_s),
+            ),
+            (
+                "sensors.alpha_rate",
+                r.noise_std,
+                r.bias,
+                r.quantum,
+                (r.stuck_from_s, r.stuck_until_s),
+            ),
         ] {
-            v.non_negative(&format!("{name}.noise_std"), sensor.noise_std);
-            v.finite(&format!("{name}.bias"), sensor.bias);
-            v.non_negative(&format!("{name}.quantum"), sensor.quantum);
+            v.non_negative(&format!("{name}.noise_std"), noise_std);
+            v.finite(&format!("{name}.bias"), bias);
+            v.non_negative(&format!("{name}.quantum"), quantum);
             v.window(
                 &format!("{name}.stuck_from_s"),
-                sensor.stuck_from_s,
+                from,
                 &format!("{name}.stuck_until_s"),
-                sensor.stuck_until_s,
+                until,
                 true,
             );
         }
+        if l.counts_per_rev > 0 {
+            v.positive("sensors.length.drum_radius_m", l.drum_radius_m);
+        } else {
+            v.non_negative("sensors.length.drum_radius_m", l.drum_radius_m);
+        }
+        v.check(
+            (0.0..=1.0).contains(&a.dropout_prob),
+            "sensors.alpha.dropout_prob",
+            num(a.dropout_prob),
+            "must be a probability, in [0, 1]",
+        );
+        let c = &self.load_cell;
+        v.non_negative("sensors.load_cell.noise_std_n", c.noise_std_n);
+        v.finite("sensors.load_cell.bias_n", c.bias_n);
+        v.non_negative("sensors.load_cell.quantum_n", c.quantum_n);
+        v.limit("sensors.load_cell.full_scale_n", c.full_scale_n);
     }
 }
 
-/// The most entries of each fault list (`[[faults.dropout]]`, `[[faults.corrupt]]`,
-/// `[[faults.length_glitch]]`): every control tick looks at each entry, so a run's cost grows
+/// The most entries of each fault list (`[[faults.dropout]]`, `[[faults.alpha_dropout]]`,
+/// `[[faults.corrupt]]`, `[[faults.length_glitch]]`): every control tick looks at each entry, so a run's cost grows
 /// with their number.
 pub const MAX_FAULT_ENTRIES: usize = 1_000;
 
@@ -181,11 +376,27 @@ impl FaultsSection {
             )
         };
         let dropout_ok = within("dropout", self.dropout.len());
+        let alpha_dropout_ok = within("alpha_dropout", self.alpha_dropout.len());
         let corrupt_ok = within("corrupt", self.corrupt.len());
         let glitch_ok = within("length_glitch", self.length_glitch.len());
         let take = |ok: bool| if ok { usize::MAX } else { 0 };
         for (i, w) in self.dropout.iter().take(take(dropout_ok)).enumerate() {
             let at = format!("faults.dropout[{i}]");
+            v.window(
+                &format!("{at}.from_s"),
+                w.from_s,
+                &format!("{at}.until_s"),
+                w.until_s,
+                false,
+            );
+        }
+        for (i, w) in self
+            .alpha_dropout
+            .iter()
+            .take(take(alpha_dropout_ok))
+            .enumerate()
+        {
+            let at = format!("faults.alpha_dropout[{i}]");
             v.window(
                 &format!("{at}.from_s"),
                 w.from_s,

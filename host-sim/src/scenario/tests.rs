@@ -141,7 +141,9 @@ fn schema_lists_every_key() {
             "length",
             "alpha",
             "alpha_rate",
-            "orbit_rate"
+            "orbit_rate",
+            "reel_rate",
+            "tension"
         ]))
     );
 }
@@ -454,6 +456,15 @@ fn every_rule_names_file_field_and_value() {
         (&["sensors.alpha_rate.quantum=-1e-6"], "sensors.alpha_rate.quantum", "-0.000001", "must not be negative"),
         (&["sensors.alpha.stuck_from_s=-5"], "sensors.alpha.stuck_from_s", "-5", "must not be negative"),
         (&["sensors.alpha.stuck_from_s=50", "sensors.alpha.stuck_until_s=40"], "sensors.alpha.stuck_until_s", "40", "must be after sensors.alpha.stuck_from_s = 50"),
+        (&["sensors.alpha.dropout_prob=1.5"], "sensors.alpha.dropout_prob", "1.5", "must be a probability, in [0, 1]"),
+        (&["sensors.alpha.dropout_prob=nan"], "sensors.alpha.dropout_prob", "NaN", "must be a probability"),
+        (&["sensors.alpha.noise_std=0.6"], "sensors.alpha.noise_std", "0.6", "beyond what the controller's estimator can be tuned for"),
+        (&["sensors.length.counts_per_rev=4096", "sensors.length.drum_radius_m=0"], "sensors.length.drum_radius_m", "0", "must be above 0"),
+        (&["sensors.length.drum_radius_m=-1"], "sensors.length.drum_radius_m", "-1", "must not be negative"),
+        (&["sensors.load_cell.noise_std_n=-1"], "sensors.load_cell.noise_std_n", "-1", "must not be negative"),
+        (&["sensors.load_cell.bias_n=inf"], "sensors.load_cell.bias_n", "inf", "finite"),
+        (&["sensors.load_cell.full_scale_n=0"], "sensors.load_cell.full_scale_n", "0", "must be above 0 (inf = no limit)"),
+        (&["faults.alpha_dropout=[{ from_s = 100, until_s = 50 }]"], "faults.alpha_dropout[0].until_s", "50", "must be after faults.alpha_dropout[0].from_s = 100"),
         (&["faults.dropout=[{ from_s = 100, until_s = 100 }]"], "faults.dropout[0].until_s", "100", "must be after faults.dropout[0].from_s = 100"),
         (&["faults.dropout=[{ from_s = inf, until_s = inf }]"], "faults.dropout[0].from_s", "inf", "finite"),
         (&["faults.corrupt=[{ sensor = \"alpha\", from_s = 5, until_s = nan, value = 0 }]"], "faults.corrupt[0].until_s", "NaN", "must be a number"),
@@ -686,11 +697,13 @@ fn a_campaign_disperses_each_field_at_most_once() {
 fn conversions_keep_the_meaning_of_the_defaults() {
     use crate::faults::{InjectionPlan, SensorErrors, Window};
     use crate::reel::ReelDrive;
-    let s = load(&[]).unwrap();
+    // The default has no α̇ sensor (the controller estimates α̇): not the paper's idealisation.
+    assert!(!InjectionPlan::from(&load(&[]).unwrap()).is_transparent());
+    let s = load(&["sensors.alpha_rate.enabled=true"]).unwrap();
     assert!(InjectionPlan::from(&s).is_transparent());
     assert!(ReelDrive::from(&s.reel).is_ideal());
     assert_eq!(
-        SensorErrors::from(&SensorSection::default()),
+        SensorErrors::from(&super::RateSensorSection::default()),
         SensorErrors::default()
     );
     let s = load(&[
@@ -701,13 +714,13 @@ fn conversions_keep_the_meaning_of_the_defaults() {
     .unwrap();
     let plan = InjectionPlan::from(&s);
     assert_eq!(
-        plan.alpha.stuck,
+        plan.alpha.errors.stuck,
         Some(Window {
             from_s: 50.0,
             until_s: f64::INFINITY
         })
     );
-    assert_eq!(plan.length.bias, 0.5);
+    assert_eq!(plan.length.errors.bias, 0.5);
     assert!(!plan.is_transparent());
     assert!(!ReelDrive::from(&s.reel).is_ideal());
     let cfg = s.controller_config::<f32>();
