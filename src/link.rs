@@ -939,9 +939,16 @@ pub fn config_digest(cfg: &crate::controller::Config<f32>) -> u32 {
             max_tension_n,
             tension_filter_s,
             drive_lag_s,
+            rate_resolution_mps,
         } = p;
         h = fnv1a(h, &[2]);
-        for x in [min_tension_n, max_tension_n, tension_filter_s, drive_lag_s] {
+        for x in [
+            min_tension_n,
+            max_tension_n,
+            tension_filter_s,
+            drive_lag_s,
+            rate_resolution_mps,
+        ] {
             h = fnv1a_f32(h, *x);
         }
     }

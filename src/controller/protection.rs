@@ -76,6 +76,11 @@ pub struct ProtectionConfig<T> {
     pub tension_filter_s: T,
     /// τ, the reel drive's first-order lag, s (0: the drive follows the command).
     pub drive_lag_s: T,
+    /// The resolution of the encoder's measured mean rate, m/s: one count per period
+    /// (2πr/N/Δt). A measured rate within it of the drive model's mean rate is the count's
+    /// rounding, not the drive's motion, and does not correct the model; beyond it the model is
+    /// corrected by the excess only. 0: every measured rate is taken as it is.
+    pub rate_resolution_mps: T,
 }
 
 impl<T: Real> ProtectionConfig<T> {
@@ -88,6 +93,7 @@ impl<T: Real> ProtectionConfig<T> {
             max_tension_n: T::from_f64(50.0),
             tension_filter_s: T::from_f64(3600.0),
             drive_lag_s: T::ZERO,
+            rate_resolution_mps: T::ZERO,
         }
     }
 
@@ -108,6 +114,18 @@ impl<T: Real> ProtectionConfig<T> {
             ));
         }
         crate::config::at_least("protection.drive_lag_s", self.drive_lag_s, T::ZERO)?;
+        crate::config::at_least(
+            "protection.rate_resolution_mps",
+            self.rate_resolution_mps,
+            T::ZERO,
+        )?;
+        if self.rate_resolution_mps > T::from_f64(MAX_PLAUSIBLE_TENSION_N) {
+            return Err(ConfigError::new(
+                "protection.rate_resolution_mps",
+                self.rate_resolution_mps,
+                Rule::TooLarge,
+            ));
+        }
         if self.max_tension_n > T::from_f64(MAX_PLAUSIBLE_TENSION_N) {
             return Err(ConfigError::new(
                 "protection.max_tension_n",
@@ -192,6 +210,8 @@ struct Lag<T> {
     decay: T,
     /// h/(e^h − 1), h = Δt/τ: v_end − u = (v̄ − u) × this (v̄ the mean over the period).
     mean_to_end: T,
+    /// Its reciprocal, (e^h − 1)/h: v̄ − u = (v_end − u) × this.
+    end_to_mean: T,
     /// h = Δt/τ.
     periods_per_lag: T,
     /// (1 − e^{−h})/h: the mean acceleration of a staircase whose peaks are 1.
@@ -256,6 +276,7 @@ impl<T: Real> Protection<T> {
                 inv_lag_per_s: T::ONE / tau,
                 decay,
                 mean_to_end: h * decay / complement,
+                end_to_mean: complement / (h * decay),
                 periods_per_lag: h,
                 ramp_fraction: complement / h,
             }
@@ -308,8 +329,26 @@ impl<T: Real> Protection<T> {
         let measured =
             measured_rate_mps.filter(|v| v.is_finite() && v.abs() <= self.max_plausible_rate_mps);
         let gap_mps = match measured {
-            // One period at `command_mps`: the mean rate over it tells the rate at its end.
-            Some(v) if elapsed_ticks == 1 => (v - command_mps) * lag.mean_to_end,
+            // One period at `command_mps`: the mean rate over it tells the rate at its end,
+            // once the count's rounding is taken out (a 4 096-count drum of r = 0.1 m reads
+            // the rate in steps of 0.15 mm/s; taken as it is, that jitter made the drive's
+            // acceleration swing by ~1e-4 m/s², the free tension by ~m_r × that ≈ 10 mN against
+            // a 2 mN margin: every run of the Monte Carlo campaign went slack; with it, 995 of
+            // 1 000 pass).
+            Some(v) if elapsed_ticks == 1 => {
+                let model_gap = (self.drive_rate_mps - command_mps) * lag.decay;
+                let model_mean = command_mps + model_gap * lag.end_to_mean;
+                let excess = v - model_mean;
+                let resolution = self.cfg.rate_resolution_mps;
+                let seen = if excess > resolution {
+                    excess - resolution
+                } else if excess < -resolution {
+                    excess + resolution
+                } else {
+                    T::ZERO
+                };
+                (model_mean + seen - command_mps) * lag.mean_to_end
+            }
             _ => {
                 let decay = if elapsed_ticks == 1 {
                     lag.decay
@@ -626,6 +665,50 @@ mod tests {
         let b = p.sample_none().bounds(None, 1.0, 1.0);
         assert!((b.overrun_out_m - 2.0 * p.drive_rate_mps).abs() < 1e-12);
         assert_eq!(b.overrun_in_m, 0.0);
+    }
+
+    /// A 4 096-count drum of r = 0.1 m read once a second: the measured mean rate is the
+    /// model's to within one count per period (0.15 mm/s), rounded either way. Within the
+    /// resolution the model stands (the drive's acceleration, m_r × which is a tension, does
+    /// not jitter); a drive that really runs faster than the model is still seen, less the
+    /// resolution.
+    #[test]
+    fn the_encoders_count_rounding_does_not_move_the_drive_model() {
+        let resolution = core::f64::consts::TAU * 0.1 / 4096.0;
+        let with_resolution = ProtectionConfig {
+            rate_resolution_mps: resolution,
+            ..cfg(0.5)
+        };
+        let mut model = protection(0.5);
+        let mut counted = Protection::new(with_resolution, MassModel::paper(), 1.0, 10.0, 0.0);
+        let mut raw = protection(0.5);
+        let mut jitter_counted: f64 = 0.0;
+        let mut jitter_raw: f64 = 0.0;
+        for k in 0..200 {
+            let rounding = if k % 2 == 0 { 0.9 } else { -0.9 } * resolution;
+            model.advance(1.0, 0.0, 1, None, None);
+            // The model's mean rate over the period, as a perfect encoder would read it.
+            let lag = model.lag.unwrap();
+            let mean = 1.0 + (model.drive_rate_mps - 1.0) * lag.end_to_mean;
+            counted.advance(1.0, 0.0, 1, Some(mean + rounding), None);
+            raw.advance(1.0, 0.0, 1, Some(mean + rounding), None);
+            jitter_counted =
+                jitter_counted.max((counted.drive_accel_mps2 - model.drive_accel_mps2).abs());
+            jitter_raw = jitter_raw.max((raw.drive_accel_mps2 - model.drive_accel_mps2).abs());
+        }
+        assert!(jitter_counted < 1e-12, "{jitter_counted}");
+        // Taken as it is, ±0.9 count is an acceleration of 8.6e-5 m/s²: 8.5 mN at m_r ≈ 99 kg,
+        // four times the 2 mN margin.
+        assert!(jitter_raw > 5e-5, "{jitter_raw}");
+        // A drive 1 mm/s faster than the model is seen, less the resolution.
+        let lag = counted.lag.unwrap();
+        let mean = 1.0 + (counted.drive_rate_mps - 1.0) * lag.decay * lag.end_to_mean;
+        counted.advance(1.0, 0.0, 1, Some(mean + 1e-3), None);
+        let seen_mean = 1.0 + (counted.drive_rate_mps - 1.0) * lag.end_to_mean;
+        assert!(
+            (seen_mean - (mean + 1e-3 - resolution)).abs() < 1e-9,
+            "{seen_mean} {mean}"
+        );
     }
 
     /// Load-cell noise of σ = 0.1 N: the estimate's scatter is at most σ√(Δt/(2τ_f)) ≈ 1.2 mN

@@ -106,8 +106,22 @@ impl Scenario {
             envelope: sc.envelope.to_envelope(),
             monitor: sc.monitor.to_monitor_config(),
             rate_source: sc.rate_source(),
-            protection: sc.protection.to_protection_config(),
+            protection: sc
+                .protection
+                .to_protection_config(sc.encoder_rate_resolution_mps()),
         }
+    }
+
+    /// One count of `[sensors.length]`'s encoder per control period, m/s: the resolution of
+    /// the reel rate it measures (0 for an encoder without counts).
+    pub fn encoder_rate_resolution_mps(&self) -> f64 {
+        let encoder = &self.sensors.length;
+        if encoder.counts_per_rev == 0 {
+            return 0.0;
+        }
+        std::f64::consts::TAU * encoder.drum_radius_m
+            / f64::from(encoder.counts_per_rev)
+            / self.controller.period_s
     }
 
     /// The masses of `[masses]` and `[tether]`, in scalar type `T`.

@@ -22,6 +22,11 @@ pub struct ProtectionSection {
     /// The reel drive's first-order lag as the controller knows it, s (0: it follows the
     /// command).
     pub drive_lag_s: f64,
+    /// The resolution of the encoder's measured rate as the controller knows it, m/s (one
+    /// count per period). Not given: worked out from `[sensors.length]`'s encoder
+    /// (2π·drum_radius_m/counts_per_rev per control period; 0 for an encoder without counts).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rate_resolution_mps: Option<f64>,
 }
 
 impl Default for ProtectionSection {
@@ -33,18 +38,28 @@ impl Default for ProtectionSection {
             max_tension_n: p.max_tension_n,
             tension_filter_s: p.tension_filter_s,
             drive_lag_s: p.drive_lag_s,
+            rate_resolution_mps: None,
         }
     }
 }
 
 impl ProtectionSection {
-    /// The controller's protection, in its scalar type `T` (None when off).
-    pub fn to_protection_config<T: tss_reel::Real>(&self) -> Option<ProtectionConfig<T>> {
+    /// The controller's protection, in its scalar type `T` (None when off);
+    /// `encoder_rate_resolution_mps` is the scenario encoder's one count per period, used when
+    /// `rate_resolution_mps` is not given.
+    pub fn to_protection_config<T: tss_reel::Real>(
+        &self,
+        encoder_rate_resolution_mps: f64,
+    ) -> Option<ProtectionConfig<T>> {
+        let resolution = self
+            .rate_resolution_mps
+            .unwrap_or(encoder_rate_resolution_mps);
         self.enabled.then(|| ProtectionConfig {
             min_tension_n: T::from_f64(self.min_tension_n),
             max_tension_n: T::from_f64(self.max_tension_n),
             tension_filter_s: T::from_f64(self.tension_filter_s),
             drive_lag_s: T::from_f64(self.drive_lag_s),
+            rate_resolution_mps: T::from_f64(resolution),
         })
     }
 }
