@@ -104,8 +104,10 @@ fn schema_lists_every_key() {
         })
     );
     assert!(s.tables.contains("stage1"));
-    // Every leaf of a serialized scenario is in the schema and vice versa.
-    let value = toml::Value::try_from(load(&[]).unwrap()).unwrap();
+    // Every leaf of a serialized scenario is in the schema and vice versa (an optional key
+    // without a default is given, so that it is serialized).
+    let value =
+        toml::Value::try_from(load(&["protection.rate_resolution_mps=0.0"]).unwrap()).unwrap();
     let mut found = BTreeSet::new();
     fn walk(v: &toml::Value, prefix: &str, out: &mut BTreeSet<String>) {
         if let toml::Value::Table(t) = v {
