@@ -603,23 +603,35 @@ impl SpeedLoop {
         // The torque: PI + feed-forward with the brake free; while it lifts, the motor takes
         // over the tension's torque, nothing else; otherwise the motor is off.
         let (ref_mps, ref_accel_mps2, torque_nm) = match self.brake {
-            Brake::Released { .. } => self.speed_law(tick, gap_ticks, speed_mps, tension_n),
-            Brake::Releasing { .. } => (0.0, 0.0, self.tension_torque_nm(tension_n)),
+            Brake::Released { .. } => {
+                let law = self.speed_law(tick, gap_ticks, speed_mps, tension_n);
+                if self.count_stall(gap_ticks, speed_mps, law.2) {
+                    faults.insert(DriveFault::MotorStall);
+                    (law.0, law.1, 0.0)
+                } else {
+                    law
+                }
+            }
+            Brake::Releasing { .. } => {
+                self.stall_ticks = 0;
+                (0.0, 0.0, self.tension_torque_nm(tension_n))
+            }
             Brake::Engaged => {
+                self.stall_ticks = 0;
                 self.integral_nm = 0.0;
                 (0.0, 0.0, 0.0)
             }
             Brake::Tripped(f) => {
                 faults.insert(f);
+                self.stall_ticks = 0;
                 self.integral_nm = 0.0;
                 (0.0, 0.0, 0.0)
             }
         };
-        let (mut duty, saturated) =
+        let (duty, saturated) =
             saturate(torque_nm * self.derived.per_max_torque, self.cfg.duty_limit);
 
-        // Saturation held too long (reported), stall (trips). The counters are only touched
-        // beyond resetting them when their condition holds (rare).
+        // Saturation held too long (reported); the stall is `count_stall`'s.
         let f = &self.cfg.faults;
         if saturated {
             self.saturated_ticks = self.saturated_ticks.saturating_add(gap_ticks);
@@ -628,19 +640,6 @@ impl SpeedLoop {
             }
         } else {
             self.saturated_ticks = 0;
-        }
-        let stalled = duty.abs() >= f.stall_duty
-            && speed_mps.abs() <= f.stall_speed_mps
-            && matches!(self.brake, Brake::Released { .. });
-        if stalled {
-            self.stall_ticks = self.stall_ticks.saturating_add(gap_ticks);
-            if self.stall_ticks >= f.stall_ticks {
-                self.trip(DriveFault::MotorStall);
-                faults.insert(DriveFault::MotorStall);
-                duty = 0.0;
-            }
-        } else {
-            self.stall_ticks = 0;
         }
 
         self.out = DriveOutput {
@@ -702,6 +701,26 @@ impl SpeedLoop {
             + self.tension_torque_nm(tension_n)
             + self.friction_torque_nm(ref_mps);
         (ref_mps, ref_accel_mps2, torque_nm)
+    }
+
+    /// The stall counter, brake free: the ticks the drive has been stalled (|duty| at or above
+    /// the stall duty, the drum slower than the stall speed), reset otherwise; at the stall
+    /// ticks it trips the drive (returns true: the step's torque is then 0). Run from the
+    /// `Released` arm of the step, it needs no test of the brake's state (the other arms reset
+    /// the counter), and the threshold is compared only while counting.
+    fn count_stall(&mut self, gap_ticks: u32, speed_mps: f32, torque_nm: f32) -> bool {
+        let f = &self.cfg.faults;
+        let duty = torque_nm * self.derived.per_max_torque;
+        if duty.abs() >= f.stall_duty && speed_mps.abs() <= f.stall_speed_mps {
+            self.stall_ticks = self.stall_ticks.saturating_add(gap_ticks);
+            if self.stall_ticks >= f.stall_ticks {
+                self.trip(DriveFault::MotorStall);
+                return true;
+            }
+        } else {
+            self.stall_ticks = 0;
+        }
+        false
     }
 
     /// Tension feed-forward −T r, N m.
