@@ -89,3 +89,29 @@ fn the_inner_rate_is_validated() {
         .expect_err("50 Hz is below the 100 Hz floor");
     assert!(format!("{err:#}").contains("reel.inner_rate_hz"), "{err:#}");
 }
+
+/// `tss-sim run` on paper-drive writes the drive's summary lines and its figure (drum rate vs
+/// command, duty) with the run's others.
+#[test]
+fn a_run_writes_the_drive_figure_and_summary() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("drive");
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper-drive.toml");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_tss-sim"))
+        .args(["run", "-q", scenario.to_str().unwrap(), "--out"])
+        .arg(&out)
+        .args(["--set", "simulation.duration_s=60"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["flight_drive.png", "flight_drive.svg"] {
+        assert!(out.join(f).metadata().unwrap().len() > 1000, "{f}");
+    }
+    let svg = std::fs::read_to_string(out.join("flight_drive.svg")).unwrap();
+    assert!(svg.contains("speed-loop duty"), "the duty panel");
+    let summary = std::fs::read_to_string(out.join("summary.txt")).unwrap();
+    assert!(
+        summary.contains("flight drive duty saturation: 0 ticks"),
+        "{summary}"
+    );
+}
