@@ -27,7 +27,10 @@ pub enum ReelModelName {
 /// dv/dt = (u − v)/lag_s, with its own rate and acceleration saturation (separate from the
 /// controller's `[envelope]`); with `model = "motor"` (elastic plant) a drum of radius r and
 /// inertia J follows u/r through a speed loop (the `drum_*`, `motor_*`, friction and brake keys;
-/// defaults: a 0.1 m, 0.05 kg·m² drum with a 2 N·m motor and a 5 rad/s speed loop).
+/// defaults: a 0.1 m, 0.05 kg·m² drum with a 2 N·m motor and a 5 rad/s speed loop); with
+/// `model = "flight_drive"` (elastic plant) the same drum is driven by the flight speed loop at
+/// `inner_rate_hz` through an encoder of `encoder_counts_per_rev` (its gains the flight
+/// drive's, `speed_bandwidth_radps` unused).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReelSection {
