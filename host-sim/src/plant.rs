@@ -324,6 +324,8 @@ pub struct ElasticObservation {
     pub reel_rate_mps: f64,
     /// Number of beads.
     pub beads: usize,
+    /// What the flight drive did so far (`reel.model = "flight_drive"` only).
+    pub drive: Option<crate::elastic::reel_drum::DriveFigures>,
 }
 
 /// One instant of a plant, as the loop records it.

@@ -44,6 +44,8 @@ pub const FIGURE_STEMS: [&str; 3] = [
 
 /// File stem of the tether's shape figure (elastic plant only).
 pub const SHAPE_STEM: &str = "tether_shape";
+/// File stem of the flight drive's figure (`reel.model = "flight_drive"` only).
+pub const DRIVE_STEM: &str = "flight_drive";
 /// Pixel size of the shape figure (square: its two axes share one scale).
 pub const SHAPE_FIGURE_SIZE_PX: (u32, u32) = (1000, 1000);
 /// Legend entries of the shape figure at most (the other curves are drawn unlabelled; their
@@ -137,7 +139,7 @@ pub fn write_png_and_svg(
 pub fn figure_names() -> Vec<String> {
     FIGURE_STEMS
         .iter()
-        .chain([&SHAPE_STEM])
+        .chain([&SHAPE_STEM, &DRIVE_STEM])
         .flat_map(|s| png_and_svg(s))
         .collect()
 }
@@ -168,6 +170,14 @@ pub fn write_figures(
             &Panels(panels),
         )?);
     }
+    if let Some(panels) = drive_panels(scenario, history) {
+        written.extend(write_png_and_svg(
+            out,
+            DRIVE_STEM,
+            FIGURE_SIZE_PX,
+            &Panels(panels),
+        )?);
+    }
     if !history.shapes.is_empty() {
         let shapes = TetherShapes {
             caption: format!(
@@ -184,6 +194,60 @@ pub fn write_figures(
         )?);
     }
     Ok(written)
+}
+
+/// The flight drive's figure: the drum's surface rate against the law's command, and the
+/// speed loop's duty, at the output samples (the last inner tick's); `None` without the drive.
+fn drive_panels(scenario: &Scenario, history: &History) -> Option<Vec<Panel>> {
+    if !history.elastic.iter().any(|e| e.drive.is_some()) {
+        return None;
+    }
+    let t_h = |s: &Sample| s.t_s / S_PER_H;
+    let pairs = || history.samples.iter().zip(&history.elastic);
+    let command = thin(pairs().map(|(s, _)| (t_h(s), s.length_rate_mps)).collect());
+    let drum = thin(pairs().map(|(s, e)| (t_h(s), e.reel_rate_mps)).collect());
+    let duty = thin(
+        pairs()
+            .filter_map(|(s, e)| e.drive.map(|d| (t_h(s), d.duty)))
+            .collect(),
+    );
+    Some(vec![
+        Panel {
+            caption: format!(
+                "Flight drive: drum rate vs command — scenario {}",
+                scenario.name
+            ),
+            x_desc: "t (h)",
+            y_desc: "l̇ (m/s)",
+            curves: vec![
+                Curve {
+                    label: "command",
+                    color: ALPHA_REF_COLOR,
+                    dashed: true,
+                    points: command,
+                },
+                Curve {
+                    label: "drum",
+                    color: LENGTH_COLOR,
+                    dashed: false,
+                    points: drum,
+                },
+            ],
+            marker_x: None,
+        },
+        Panel {
+            caption: "Flight drive: speed-loop duty".to_string(),
+            x_desc: "t (h)",
+            y_desc: "duty",
+            curves: vec![Curve {
+                label: "duty",
+                color: TENSION_COLOR,
+                dashed: false,
+                points: duty,
+            }],
+            marker_x: None,
+        },
+    ])
 }
 
 /// The tether's shape at some instants, in the plane of the orbit: along-track (e_θ) against

@@ -88,6 +88,8 @@ pub struct Summary {
     pub flag_counts: Vec<(&'static str, usize)>,
     /// The last sample.
     pub last: Option<Sample>,
+    /// What the flight drive did (`reel.model = "flight_drive"`).
+    pub drive: Option<crate::elastic::reel_drum::DriveFigures>,
 }
 
 /// First time, interpolated, at which the length crosses into `reached` among `samples` (in
@@ -237,6 +239,7 @@ pub fn summarize(scenario: &Scenario, history: &History) -> Summary {
         flagged,
         flag_counts,
         last: samples.last().copied(),
+        drive: history.elastic.last().and_then(|e| e.drive),
     }
 }
 
@@ -319,6 +322,37 @@ impl Summary {
                 let _ = write!(o, ", {} non-finite", t.non_finite);
             }
             let _ = writeln!(o, ")");
+        }
+        if let Some(d) = &self.drive {
+            let _ = writeln!(
+                o,
+                "  flight drive tracking error: RMS {:.6} m/s, max {:.6} m/s ({} ticks released of {})",
+                d.rms_error_mps(),
+                d.max_error_mps,
+                d.released_ticks,
+                d.ticks
+            );
+            let _ = writeln!(
+                o,
+                "  flight drive duty saturation: {} ticks, fraction {:.6}",
+                d.saturated_ticks,
+                d.saturated_fraction()
+            );
+            if d.fault_bits == 0 {
+                let _ = writeln!(o, "  flight drive faults seen: none");
+            } else {
+                let _ = writeln!(
+                    o,
+                    "  flight drive faults seen: bits {:#06x} (DriveFault::ALL order)",
+                    d.fault_bits
+                );
+            }
+            let _ = writeln!(
+                o,
+                "  flight drive tension at the reel (N): min {} max {}",
+                newtons(d.tension_range_n.0),
+                newtons(d.tension_range_n.1)
+            );
         }
         let (n, or) = self.flagged;
         if n == 0 {

@@ -39,7 +39,7 @@ pub mod tether;
 use crate::plant::{Command, ElasticObservation, Observation, Plant, SensorTruth};
 use crate::reel::{Reel, ReelSaturation};
 use environment::{air_velocity_mps, body_drag_n, cylinder_drag_n, Environment, Vec3};
-use reel_drum::{DrumParams, Motion};
+use reel_drum::{DriveFigures, DrumParams, FlightDrum, Motion};
 use tether::{Feed, Layout, TetherParams};
 use tss_reel::orbit::Orbit;
 
@@ -78,6 +78,33 @@ pub enum ReelModel {
     Lag(Reel),
     /// The drum and motor of [`reel_drum`], through its speed loop.
     Motor(DrumParams),
+    /// The drum of [`reel_drum`] driven by the flight speed loop ([`FlightDrum`]) at its inner
+    /// rate: the plant substeps at every inner tick, the motor's torque held over it.
+    Flight(FlightParams),
+}
+
+/// The drum and the flight speed loop that drives it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlightParams {
+    /// The drum (its `speed_bandwidth_radps` unused: the flight loop's gains fly).
+    pub drum: DrumParams,
+    /// The speed loop's inner rate, Hz (≥ 100).
+    pub inner_rate_hz: u32,
+    /// Encoder counts per drum revolution.
+    pub counts_per_rev: u32,
+    /// The law's period, s (the drive's outer period).
+    pub period_s: f64,
+}
+
+impl FlightParams {
+    /// The drive configuration the flight loop flies ([`FlightDrum::drive_config`], with this
+    /// encoder on the drum's shaft).
+    pub fn drive_config(&self) -> tss_reel::reel_drive::DriveConfig {
+        let mut cfg = FlightDrum::drive_config(&self.drum, self.inner_rate_hz, self.period_s);
+        cfg.geometry.counts_per_motor_rev = self.counts_per_rev;
+        cfg.geometry.gear_ratio = 1;
+        cfg
+    }
 }
 
 /// The reel.
@@ -276,37 +303,22 @@ impl ElasticParams {
                     "> 0",
                 )?;
             }
-            ReelModel::Motor(d) => {
-                check("reel.drum_radius_m", d.radius_m, d.radius_m > 0.0, "> 0")?;
-                check(
-                    "reel.inertia_kgm2",
-                    d.inertia_kgm2,
-                    d.inertia_kgm2 > 0.0,
-                    "> 0",
-                )?;
-                check(
-                    "reel.viscous_nms",
-                    d.viscous_nms,
-                    d.viscous_nms >= 0.0,
-                    ">= 0",
-                )?;
-                check("reel.coulomb_nm", d.coulomb_nm, d.coulomb_nm >= 0.0, ">= 0")?;
-                check(
-                    "reel.static_nm",
-                    d.static_nm,
-                    d.static_nm >= d.coulomb_nm,
-                    ">= coulomb_nm",
-                )?;
-                check(
-                    "reel.max_torque_nm",
-                    d.max_torque_nm,
-                    d.max_torque_nm > 0.0,
-                    "> 0",
-                )?;
-                check("reel.brake_nm", d.brake_nm, d.brake_nm >= 0.0, ">= 0")?;
-                let w = d.speed_bandwidth_radps;
-                check("reel.speed_bandwidth_radps", w, w > 0.0, "> 0")?;
+            ReelModel::Flight(f) => {
+                check_drum(&f.drum)?;
+                let hz = f64::from(f.inner_rate_hz);
+                check("reel.inner_rate_hz", hz, hz >= 100.0, ">= 100")?;
+                let c = f64::from(f.counts_per_rev);
+                check("reel.encoder_counts_per_rev", c, c > 0.0, "> 0")?;
+                check("period_s", f.period_s, f.period_s > 0.0, "> 0")?;
+                if f.drive_config().validate().is_err() {
+                    return Err(ElasticError::Invalid {
+                        field: "reel (flight drive configuration)",
+                        value: hz,
+                        rule: "a valid tss_reel::reel_drive::DriveConfig",
+                    });
+                }
             }
+            ReelModel::Motor(d) => check_drum(d)?,
         }
         check(
             "courant",
@@ -315,6 +327,40 @@ impl ElasticParams {
             "in (0, 2]",
         )
     }
+}
+
+/// The drum's parameters in range.
+fn check_drum(d: &DrumParams) -> Result<(), ElasticError> {
+    check("reel.drum_radius_m", d.radius_m, d.radius_m > 0.0, "> 0")?;
+    check(
+        "reel.inertia_kgm2",
+        d.inertia_kgm2,
+        d.inertia_kgm2 > 0.0,
+        "> 0",
+    )?;
+    check(
+        "reel.viscous_nms",
+        d.viscous_nms,
+        d.viscous_nms >= 0.0,
+        ">= 0",
+    )?;
+    check("reel.coulomb_nm", d.coulomb_nm, d.coulomb_nm >= 0.0, ">= 0")?;
+    check(
+        "reel.static_nm",
+        d.static_nm,
+        d.static_nm >= d.coulomb_nm,
+        ">= coulomb_nm",
+    )?;
+    check(
+        "reel.max_torque_nm",
+        d.max_torque_nm,
+        d.max_torque_nm > 0.0,
+        "> 0",
+    )?;
+    check("reel.brake_nm", d.brake_nm, d.brake_nm >= 0.0, ">= 0")?;
+    let w = d.speed_bandwidth_radps;
+    check("reel.speed_bandwidth_radps", w, w > 0.0, "> 0")?;
+    Ok(())
 }
 
 /// The integrated state: the reference particle, the reel, and every node relative to the
@@ -375,6 +421,13 @@ enum ReelDrive {
         drum: DrumParams,
         command_radps: f64,
         tension_n: Option<f64>,
+        motion: Motion,
+        brake: bool,
+    },
+    /// The drum under a motor torque held over the inner tick (the flight drive).
+    Held {
+        drum: DrumParams,
+        torque_nm: f64,
         motion: Motion,
         brake: bool,
     },
@@ -505,6 +558,18 @@ enum ReelState {
         /// Stuck or slipping.
         motion: Motion,
     },
+    /// The drum under the flight speed loop ([`FlightDrum`], kept in the plant): the torque
+    /// and brake of the current inner tick.
+    Flight {
+        /// Its parameters.
+        drum: DrumParams,
+        /// Stuck or slipping.
+        motion: Motion,
+        /// Motor torque held over the tick, N·m.
+        torque_nm: f64,
+        /// The spring brake engaged.
+        brake: bool,
+    },
 }
 
 /// The truth model, stepped one control period at a time.
@@ -526,6 +591,12 @@ pub struct ElasticPlant {
     /// The tension command of the current period (a tension law drives the drum's torque),
     /// N; `None` under a rate command.
     tension_cmd_n: Option<f64>,
+    /// The acceleration the law commanded with the current period's rate (Eq. 30), m/s²
+    /// (the flight drive's ramp feeds it forward).
+    accel_cmd_mps2: f64,
+    /// The flight speed loop (flight reel only) and the paid-out length its encoder counts
+    /// from, m.
+    flight: Option<(Box<FlightDrum>, f64)>,
     ws: Workspace,
 }
 
@@ -619,6 +690,26 @@ impl ElasticPlant {
                 };
                 ReelState::Motor { drum, motion }
             }
+            // The flight drive starts at rest with its brake engaged (it releases it itself).
+            ReelModel::Flight(f) => ReelState::Flight {
+                drum: f.drum,
+                motion: Motion::Stuck,
+                torque_nm: 0.0,
+                brake: true,
+            },
+        };
+        let flight = match p.reel.model {
+            ReelModel::Flight(f) if !locked => {
+                let drum = FlightDrum::new(f.drum, f.drive_config()).map_err(|_| {
+                    ElasticError::Invalid {
+                        field: "reel (flight drive configuration)",
+                        value: f64::from(f.inner_rate_hz),
+                        rule: "a valid tss_reel::reel_drive::DriveConfig",
+                    }
+                })?;
+                Some((Box::new(drum), init.length_m))
+            }
+            _ => None,
         };
         let y = State {
             r_ref: r_c,
@@ -631,6 +722,7 @@ impl ElasticPlant {
         };
         let reel_rate_mps = match reel {
             ReelState::Lag(r) => r.rate_mps,
+            ReelState::Flight { .. } => 0.0,
             _ => rate,
         };
         Ok(Self {
@@ -644,6 +736,8 @@ impl ElasticPlant {
             substeps_last: 0,
             period_hint_s: 1.0,
             tension_cmd_n: None,
+            accel_cmd_mps2: 0.0,
+            flight,
             ws: Workspace::default(),
         })
     }
@@ -828,6 +922,9 @@ impl ElasticPlant {
                 ReelState::Motor {
                     motion: Motion::Stuck,
                     ..
+                } | ReelState::Flight {
+                    motion: Motion::Stuck,
+                    ..
                 }
             ),
         }
@@ -869,6 +966,14 @@ impl ElasticPlant {
             ReelState::Locked => 0.0,
             _ => command_mps,
         };
+        if self.flight.is_some() {
+            self.step_flight(command, period_s)?;
+            self.t_s += period_s;
+            self.reel_rate_mps = self
+                .drum()
+                .map_or(0.0, |d| d.radius_m * self.y.drum_speed_radps);
+            return Ok(());
+        }
         let n = (period_s * self.fastest_rate() / self.p.courant)
             .ceil()
             .max(1.0);
@@ -895,9 +1000,84 @@ impl ElasticPlant {
                 r.advance(command, period_s);
                 r.rate_mps
             }
-            ReelState::Motor { drum, .. } => drum.radius_m * self.y.drum_speed_radps,
+            ReelState::Motor { drum, .. } | ReelState::Flight { drum, .. } => {
+                drum.radius_m * self.y.drum_speed_radps
+            }
         };
         Ok(())
+    }
+
+    /// One law period of the flight drive: the law's `command` reaches the speed loop, which
+    /// then runs at its inner rate, each tick reading the encoder (the paid-out length turned
+    /// into drum counts) and the tension at the reel, its torque held over the tick while the
+    /// plant integrates.
+    fn step_flight(&mut self, command: f64, period_s: f64) -> Result<(), ElasticError> {
+        let Some((mut flight, start_m)) = self.flight.take() else {
+            return Ok(());
+        };
+        let result = self.fly_period(&mut flight, start_m, command, period_s);
+        self.flight = Some((flight, start_m));
+        result
+    }
+
+    fn fly_period(
+        &mut self,
+        flight: &mut FlightDrum,
+        start_m: f64,
+        command: f64,
+        period_s: f64,
+    ) -> Result<(), ElasticError> {
+        let Some(d) = self.drum() else {
+            return Ok(());
+        };
+        let hz = f64::from(flight.speed_loop().config().inner_rate_hz);
+        let ticks = (period_s * hz).round().max(1.0) as u32;
+        let dt = period_s / f64::from(ticks);
+        flight.begin_period(
+            tss_reel::reel_drive::RateCommand {
+                rate_mps: command as f32,
+                accel_mps2: self.accel_cmd_mps2 as f32,
+                safe_hold: false,
+            },
+            self.reel_tension_n(&d),
+        );
+        let mut substeps = 0;
+        for tick in 0..ticks {
+            let angle_rad = (self.y.paid_out_m - start_m) / d.radius_m;
+            let (torque_nm, brake) = flight.start_tick(angle_rad, self.reel_tension_n(&d));
+            if let ReelState::Flight {
+                torque_nm: t,
+                brake: b,
+                ..
+            } = &mut self.reel
+            {
+                (*t, *b) = (torque_nm, brake);
+            }
+            let n = (dt * self.fastest_rate() / self.p.courant).ceil().max(1.0) as u32;
+            substeps += n;
+            let h = dt / f64::from(n);
+            for k in 0..n {
+                self.substep(command, f64::from(tick) * dt + f64::from(k) * h, h);
+                if !self.y.is_finite() {
+                    return Err(ElasticError::Diverged {
+                        t_s: self.t_s + f64::from(tick) * dt + f64::from(k) * h,
+                    });
+                }
+            }
+            flight.end_tick(d.radius_m * self.y.drum_speed_radps);
+        }
+        flight.end_period(command, d.radius_m * self.y.drum_speed_radps);
+        self.substeps_last = substeps;
+        Ok(())
+    }
+
+    /// What the flight drive did so far (flight reel only).
+    pub fn drive_figures(&self) -> Option<DriveFigures> {
+        self.flight.as_ref().map(|(f, _)| {
+            let mut figures = *f.figures();
+            figures.duty = f.duty();
+            figures
+        })
     }
 
     /// The reel's drive at `t_in_period_s` into the period under `command`.
@@ -913,20 +1093,31 @@ impl ElasticPlant {
                 motion,
                 brake,
             },
+            ReelState::Flight {
+                drum,
+                motion,
+                torque_nm,
+                brake,
+            } => ReelDrive::Held {
+                drum,
+                torque_nm,
+                motion,
+                brake,
+            },
         }
     }
 
     /// The drum's parameters, if a motor reel is turning (not locked).
     fn drum(&self) -> Option<DrumParams> {
         match self.reel {
-            ReelState::Motor { drum, .. } => Some(drum),
+            ReelState::Motor { drum, .. } | ReelState::Flight { drum, .. } => Some(drum),
             _ => None,
         }
     }
 
     /// Sets the drum's stick/slip state (motor reel).
     fn set_motion(&mut self, to: Motion) {
-        if let ReelState::Motor { motion, .. } = &mut self.reel {
+        if let ReelState::Motor { motion, .. } | ReelState::Flight { motion, .. } = &mut self.reel {
             *motion = to;
         }
     }
@@ -934,7 +1125,7 @@ impl ElasticPlant {
     /// The drum's stick/slip state (stuck for every other reel).
     fn motion(&self) -> Motion {
         match self.reel {
-            ReelState::Motor { motion, .. } => motion,
+            ReelState::Motor { motion, .. } | ReelState::Flight { motion, .. } => motion,
             _ => Motion::Stuck,
         }
     }
@@ -943,7 +1134,10 @@ impl ElasticPlant {
     /// switch and the feeding rule.
     fn substep(&mut self, command: f64, t0: f64, h: f64) {
         // The brake holds a zero rate command; a tension law commands the motor, never the brake.
-        let brake = command == 0.0 && self.tension_cmd_n.is_none();
+        let brake = match self.reel {
+            ReelState::Flight { brake, .. } => brake,
+            _ => command == 0.0 && self.tension_cmd_n.is_none(),
+        };
         let motor = self.drum();
         if let Some(d) = motor {
             let drive = self.drum_drive_nm(&d, command);
@@ -1033,19 +1227,11 @@ impl ElasticPlant {
 
     /// τ_m + r T_reel at the current state, N·m.
     fn drum_drive_nm(&self, d: &DrumParams, command: f64) -> f64 {
+        let tension = self.reel_tension_n(d);
+        if let ReelState::Flight { torque_nm, .. } = self.reel {
+            return torque_nm + d.radius_m * tension;
+        }
         let y = &self.y;
-        let dvec = y.pos[1] - y.pos[0];
-        let chord = dvec.norm();
-        let rate = if chord > 0.0 {
-            (y.vel[1] - y.vel[0]).dot(&dvec) / chord
-        } else {
-            0.0
-        };
-        let l = self.layout.reel_segment_m(&self.p.tether, y.paid_out_m);
-        let tension = self
-            .p
-            .tether
-            .tension_n(chord, rate, l, d.radius_m * y.drum_speed_radps);
         let (torque, _) = motor_torque(
             d,
             self.tension_cmd_n,
@@ -1055,6 +1241,22 @@ impl ElasticPlant {
             y.drum_integral_rad,
         );
         torque + d.radius_m * tension
+    }
+
+    /// The tension of the reel segment at the current state, N.
+    fn reel_tension_n(&self, d: &DrumParams) -> f64 {
+        let y = &self.y;
+        let dvec = y.pos[1] - y.pos[0];
+        let chord = dvec.norm();
+        let rate = if chord > 0.0 {
+            (y.vel[1] - y.vel[0]).dot(&dvec) / chord
+        } else {
+            0.0
+        };
+        let l = self.layout.reel_segment_m(&self.p.tether, y.paid_out_m);
+        self.p
+            .tether
+            .tension_n(chord, rate, l, d.radius_m * y.drum_speed_radps)
     }
 
     /// Applies the feeding rule until the reel segment is inside its band.
@@ -1100,8 +1302,14 @@ fn derivative(
         ReelDrive::Drum {
             motion: Motion::Stuck,
             ..
+        }
+        | ReelDrive::Held {
+            motion: Motion::Stuck,
+            ..
         } => 0.0,
-        ReelDrive::Drum { drum, .. } => drum.radius_m * y.drum_speed_radps,
+        ReelDrive::Drum { drum, .. } | ReelDrive::Held { drum, .. } => {
+            drum.radius_m * y.drum_speed_radps
+        }
     };
     dy.r_ref = y.v_ref;
     let g_ref = env.gravity(&y.r_ref);
@@ -1184,6 +1392,18 @@ fn derivative(
             let accel = d.accel_radps2(motion, drive, y.drum_speed_radps, brake);
             (accel, integral_rate)
         }
+        ReelDrive::Held {
+            drum: d,
+            torque_nm,
+            motion,
+            brake,
+        } => {
+            let drive = torque_nm + d.radius_m * tension_reel;
+            (
+                d.accel_radps2(motion, drive, y.drum_speed_radps, brake),
+                0.0,
+            )
+        }
     };
 }
 
@@ -1252,6 +1472,13 @@ impl ElasticPlant {
                     accel: demand.abs() > d.max_torque_nm,
                 }
             }
+            ReelState::Flight { .. } => ReelSaturation {
+                rate: false,
+                accel: self
+                    .flight
+                    .as_ref()
+                    .is_some_and(|(f, _)| f.speed_loop().output().saturated),
+            },
             _ => ReelSaturation::default(),
         }
     }
@@ -1300,6 +1527,7 @@ impl Plant for ElasticPlant {
                 alpha_sensed_rad: sensed.alpha_rad,
                 reel_rate_mps: m.reel_rate_mps,
                 beads: m.beads,
+                drive: self.drive_figures(),
             }),
         }
     }
@@ -1307,6 +1535,7 @@ impl Plant for ElasticPlant {
     fn step(&mut self, command: &Command, period_s: f64) {
         self.period_hint_s = period_s;
         self.tension_cmd_n = command.tension_n;
+        self.accel_cmd_mps2 = command.accel_mps2;
         // A non-finite state ends the period early; `is_finite` reports it to the loop.
         let _ = ElasticPlant::step(self, command.rate_mps, period_s);
     }

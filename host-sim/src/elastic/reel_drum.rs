@@ -199,6 +199,8 @@ pub struct DriveFigures {
     pub tension_range_n: (f64, f64),
     /// Every drive fault seen (bits of `tss_reel::reel_drive::DriveFaults`).
     pub fault_bits: u16,
+    /// The last tick's duty, −1…1 (filled by `ElasticPlant::drive_figures`).
+    pub duty: f64,
 }
 
 impl DriveFigures {
@@ -292,33 +294,92 @@ impl FlightDrum {
         &self.speed
     }
 
+    /// Starts a law period: the law's `command` reaches the drive, the tether pulling with
+    /// `tension_n` at the reel.
+    pub fn begin_period(&mut self, command: tss_reel::reel_drive::RateCommand, tension_n: f64) {
+        let _ = self.speed.set_command(command, self.tick);
+        self.note_tension(tension_n);
+    }
+
+    fn note_tension(&mut self, tension_n: f64) {
+        let f = &mut self.figures;
+        f.tension_range_n.0 = f.tension_range_n.0.min(tension_n);
+        f.tension_range_n.1 = f.tension_range_n.1.max(tension_n);
+    }
+
+    /// The drum's angle `angle_rad` (from the start) as the encoder's wrapping count.
+    fn encoder_count(&self, angle_rad: f64) -> u32 {
+        ((angle_rad * self.counts_per_rad).floor() as i64 as u32) & self.encoder_mask
+    }
+
+    /// One inner tick of the flight speed loop: reads the encoder at the drum's angle
+    /// `angle_rad` (from the start) and the load cell's `tension_n`; returns the motor torque to
+    /// hold over the tick, N·m, and whether the brake is engaged. Close it with
+    /// [`FlightDrum::end_tick`] once the drum has moved.
+    pub fn start_tick(&mut self, angle_rad: f64, tension_n: f64) -> (f64, bool) {
+        use tss_reel::reel_drive::DriveInput;
+        let out = *self.speed.step(&DriveInput {
+            tick: self.tick,
+            encoder_count: Some(self.encoder_count(angle_rad)),
+            tension_n: Some(tension_n as f32),
+        });
+        self.note_tension(tension_n);
+        let brake = !out.brake.brake_released();
+        let motor_nm = (f64::from(out.duty) * self.torque_per_duty_nm)
+            .clamp(-self.params.max_torque_nm, self.params.max_torque_nm);
+        (motor_nm, brake)
+    }
+
+    /// Ends the tick [`FlightDrum::start_tick`] began, the drum turning at `speed_mps` (surface)
+    /// at its end: the tracking, saturation and fault figures. Returns |drum speed − reference|
+    /// with the brake released, m/s.
+    pub fn end_tick(&mut self, speed_mps: f64) -> Option<f64> {
+        let out = *self.speed.output();
+        let f = &mut self.figures;
+        f.ticks += 1;
+        f.saturated_ticks += u64::from(out.saturated);
+        f.fault_bits |= out.faults.bits();
+        self.tick = self.tick.wrapping_add(1);
+        if matches!(out.brake, tss_reel::reel_drive::Brake::Released { .. }) {
+            let error = speed_mps - f64::from(out.ref_rate_mps);
+            f.released_ticks += 1;
+            f.sum_sq_error += error * error;
+            f.max_error_mps = f.max_error_mps.max(error.abs());
+            Some(error.abs())
+        } else {
+            None
+        }
+    }
+
+    /// Ends a law period under `command_mps`, the drum at `speed_mps`.
+    pub fn end_period(&mut self, command_mps: f64, speed_mps: f64) {
+        let end_error = (speed_mps - command_mps).abs();
+        let f = &mut self.figures;
+        f.max_period_end_error_mps = f.max_period_end_error_mps.max(end_error);
+    }
+
+    /// The last tick's duty, −1…1.
+    pub fn duty(&self) -> f64 {
+        f64::from(self.speed.output().duty)
+    }
+
     /// One law period of `ticks` inner ticks under the law's `command`, the tether pulling
-    /// with `tension_n` at the reel. Returns the drum's surface speed at its end, m/s, and the
-    /// period's largest |drum speed − reference| with the brake released, m/s.
+    /// with `tension_n` at the reel, the drum integrated here. Returns the drum's surface speed
+    /// at its end, m/s, and the period's largest |drum speed − reference| with the brake
+    /// released, m/s.
     pub fn period(
         &mut self,
         command: tss_reel::reel_drive::RateCommand,
         tension_n: f64,
         ticks: u32,
     ) -> (f64, f64) {
-        use tss_reel::reel_drive::DriveInput;
         let mut period_max_mps: f64 = 0.0;
-        let _ = self.speed.set_command(command, self.tick);
+        self.begin_period(command, tension_n);
         let dt = 1.0 / f64::from(self.speed.config().inner_rate_hz);
         let h = dt / f64::from(self.substeps);
-        let f = &mut self.figures;
-        f.tension_range_n.0 = f.tension_range_n.0.min(tension_n);
-        f.tension_range_n.1 = f.tension_range_n.1.max(tension_n);
         for _ in 0..ticks {
-            let raw = (self.angle_counts.floor() as i64 as u32) & self.encoder_mask;
-            let out = *self.speed.step(&DriveInput {
-                tick: self.tick,
-                encoder_count: Some(raw),
-                tension_n: Some(tension_n as f32),
-            });
-            let brake = !out.brake.brake_released();
-            let motor_nm = (f64::from(out.duty) * self.torque_per_duty_nm)
-                .clamp(-self.params.max_torque_nm, self.params.max_torque_nm);
+            let angle_rad = self.angle_counts / self.counts_per_rad;
+            let (motor_nm, brake) = self.start_tick(angle_rad, tension_n);
             let drive_nm = motor_nm + self.params.radius_m * tension_n;
             for _ in 0..self.substeps {
                 let p = &self.params;
@@ -330,22 +391,11 @@ impl FlightDrum {
                 self.motion = motion;
                 self.rate_radps = rate;
             }
-            let f = &mut self.figures;
-            f.ticks += 1;
-            f.saturated_ticks += u64::from(out.saturated);
-            f.fault_bits |= out.faults.bits();
-            if matches!(out.brake, tss_reel::reel_drive::Brake::Released { .. }) {
-                let error = self.rate_radps * self.params.radius_m - f64::from(out.ref_rate_mps);
-                f.released_ticks += 1;
-                f.sum_sq_error += error * error;
-                f.max_error_mps = f.max_error_mps.max(error.abs());
-                period_max_mps = period_max_mps.max(error.abs());
+            if let Some(e) = self.end_tick(self.speed_mps()) {
+                period_max_mps = period_max_mps.max(e);
             }
-            self.tick = self.tick.wrapping_add(1);
         }
-        let end_error = (self.speed_mps() - f64::from(command.rate_mps)).abs();
-        let f = &mut self.figures;
-        f.max_period_end_error_mps = f.max_period_end_error_mps.max(end_error);
+        self.end_period(f64::from(command.rate_mps), self.speed_mps());
         (self.speed_mps(), period_max_mps)
     }
 }

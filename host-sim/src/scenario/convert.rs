@@ -17,7 +17,9 @@ use tss_reel::estimator;
 use crate::elastic::environment::Environment;
 use crate::elastic::reel_drum::DrumParams;
 use crate::elastic::tether::TetherParams;
-use crate::elastic::{BodyParams, ElasticParams, OrbitParams, ReelModel, ReelParams, Sensing};
+use crate::elastic::{
+    BodyParams, ElasticParams, FlightParams, OrbitParams, ReelModel, ReelParams, Sensing,
+};
 use crate::faults::{
     Corruption, FaultSetup, Glitch, InjectionPlan, SensedQuantity, SensorErrors, Window,
 };
@@ -317,16 +319,23 @@ impl From<&Scenario> for ElasticParams {
     fn from(sc: &Scenario) -> Self {
         let (t, r, e) = (&sc.tether, &sc.reel, &sc.environment);
         let orbit = Orbit::elliptic(sc.orbit.semi_major_axis_m, sc.orbit.eccentricity);
+        let drum = DrumParams {
+            radius_m: r.drum_radius_m,
+            inertia_kgm2: r.drum_inertia_kgm2,
+            viscous_nms: r.viscous_nms,
+            coulomb_nm: r.coulomb_nm,
+            static_nm: r.static_nm,
+            max_torque_nm: r.motor_max_torque_nm,
+            brake_nm: r.brake_nm,
+            speed_bandwidth_radps: r.speed_bandwidth_radps,
+        };
         let model = match r.model {
-            ReelModelName::Motor => ReelModel::Motor(DrumParams {
-                radius_m: r.drum_radius_m,
-                inertia_kgm2: r.drum_inertia_kgm2,
-                viscous_nms: r.viscous_nms,
-                coulomb_nm: r.coulomb_nm,
-                static_nm: r.static_nm,
-                max_torque_nm: r.motor_max_torque_nm,
-                brake_nm: r.brake_nm,
-                speed_bandwidth_radps: r.speed_bandwidth_radps,
+            ReelModelName::Motor => ReelModel::Motor(drum),
+            ReelModelName::FlightDrive => ReelModel::Flight(FlightParams {
+                drum,
+                inner_rate_hz: r.inner_rate_hz,
+                counts_per_rev: r.encoder_counts_per_rev,
+                period_s: sc.controller.period_s,
             }),
             ReelModelName::Drive => {
                 let drive = ReelDrive::from(r);

@@ -209,6 +209,12 @@ impl Scenario {
             needs,
         );
         v.check(
+            self.reel.model != ReelModelName::FlightDrive,
+            "reel.model",
+            "\"flight_drive\"".to_string(),
+            needs,
+        );
+        v.check(
             !self.environment.j2,
             "environment.j2",
             "true".to_string(),

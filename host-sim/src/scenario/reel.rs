@@ -16,6 +16,10 @@ pub enum ReelModelName {
     /// The drum and motor with a speed loop, friction, torque limit and brake
     /// (`crate::elastic::reel_drum`; elastic plant only).
     Motor,
+    /// The same drum driven by the flight speed loop (`tss_reel::reel_drive::SpeedLoop`) at
+    /// `inner_rate_hz` through a quantised encoder (`crate::elastic::reel_drum::FlightDrum`;
+    /// elastic plant only).
+    FlightDrive,
 }
 
 /// `[reel]`: the physical reel between the command and the tether. With `model = "drive"`
@@ -23,11 +27,14 @@ pub enum ReelModelName {
 /// dv/dt = (u − v)/lag_s, with its own rate and acceleration saturation (separate from the
 /// controller's `[envelope]`); with `model = "motor"` (elastic plant) a drum of radius r and
 /// inertia J follows u/r through a speed loop (the `drum_*`, `motor_*`, friction and brake keys;
-/// defaults: a 0.1 m, 0.05 kg·m² drum with a 2 N·m motor and a 5 rad/s speed loop).
+/// defaults: a 0.1 m, 0.05 kg·m² drum with a 2 N·m motor and a 5 rad/s speed loop); with
+/// `model = "flight_drive"` (elastic plant) the same drum is driven by the flight speed loop at
+/// `inner_rate_hz` through an encoder of `encoder_counts_per_rev` (its gains the flight
+/// drive's, `speed_bandwidth_radps` unused).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReelSection {
-    /// `"drive"` (default) or `"motor"`.
+    /// `"drive"` (default), `"motor"` or `"flight_drive"`.
     #[serde(default)]
     pub model: ReelModelName,
     /// Hold the drum still: the tether neither pays out nor winds in, and the controller's
@@ -67,6 +74,12 @@ pub struct ReelSection {
     /// Motor: speed-loop bandwidth (a double closed-loop pole at −ω_b), rad/s.
     #[serde(default = "default_speed_bandwidth_radps")]
     pub speed_bandwidth_radps: f64,
+    /// Flight drive: the speed loop's inner rate, Hz (≥ 100; the plant substeps at it).
+    #[serde(default = "default_inner_rate_hz")]
+    pub inner_rate_hz: u32,
+    /// Flight drive: encoder counts per drum revolution.
+    #[serde(default = "default_encoder_counts_per_rev")]
+    pub encoder_counts_per_rev: u32,
 }
 
 impl Default for ReelSection {
@@ -85,6 +98,8 @@ impl Default for ReelSection {
             motor_max_torque_nm: default_motor_max_torque_nm(),
             brake_nm: default_brake_nm(),
             speed_bandwidth_radps: default_speed_bandwidth_radps(),
+            inner_rate_hz: default_inner_rate_hz(),
+            encoder_counts_per_rev: default_encoder_counts_per_rev(),
         }
     }
 }
@@ -116,6 +131,13 @@ fn default_brake_nm() -> f64 {
 fn default_speed_bandwidth_radps() -> f64 {
     5.0
 }
+fn default_inner_rate_hz() -> u32 {
+    1000
+}
+fn default_encoder_counts_per_rev() -> u32 {
+    // The reference reel's: 4096 counts a motor turn through a 10:1 gearbox.
+    40_960
+}
 
 impl ReelSection {
     /// A lag ≥ 0; saturations above 0 (inf = none); a drum of positive radius, inertia,
@@ -142,5 +164,17 @@ impl ReelSection {
         v.positive("reel.motor_max_torque_nm", self.motor_max_torque_nm);
         v.non_negative("reel.brake_nm", self.brake_nm);
         v.positive("reel.speed_bandwidth_radps", self.speed_bandwidth_radps);
+        v.check(
+            self.inner_rate_hz >= 100,
+            "reel.inner_rate_hz",
+            num(f64::from(self.inner_rate_hz)),
+            "must be at least 100 Hz",
+        );
+        v.check(
+            self.encoder_counts_per_rev > 0,
+            "reel.encoder_counts_per_rev",
+            num(f64::from(self.encoder_counts_per_rev)),
+            "must be positive",
+        );
     }
 }
