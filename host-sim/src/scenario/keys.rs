@@ -353,7 +353,7 @@ fn masked(message: &str) -> String {
 
 /// The names of the number keys that have no unit: ratios, coefficients and counts (the last
 /// part of the key; `tss-sim scenario keys` shows "-" for them).
-pub const DIMENSIONLESS_NAMES: [&str; 12] = [
+pub const DIMENSIONLESS_NAMES: [&str; 13] = [
     "eccentricity",
     "courant",
     "drag_coefficient",
@@ -361,6 +361,7 @@ pub const DIMENSIONLESS_NAMES: [&str; 12] = [
     "substeps",
     "good_samples_per_bad",
     "counts_per_rev",
+    "encoder_counts_per_rev",
     // The tension laws' gains (`[controller.rupp]`, `[controller.tracking]`): in units of Ω.
     "length_gain",
     "rate_gain",
