@@ -376,6 +376,7 @@ pub fn unit_of(key: &str) -> &'static str {
     // Longest first where one suffix ends another (`_kgm2` before `_m2`).
     const SUFFIXES: &[(&str, &str)] = &[
         ("_kg_per_m", "kg/m"),
+        ("_hz", "Hz"),
         ("_rad_per_m", "rad/m"),
         ("_per_s2", "1/s²"),
         ("_per_s", "1/s"),
