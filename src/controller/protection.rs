@@ -79,7 +79,8 @@ pub struct ProtectionConfig<T> {
     /// The resolution of the encoder's measured mean rate, m/s: one count per period
     /// (2πr/N/Δt). A measured rate within it of the drive model's mean rate is the count's
     /// rounding, not the drive's motion, and does not correct the model; beyond it the model is
-    /// corrected by the excess only. 0: every measured rate is taken as it is.
+    /// corrected by the excess only. 0: every measured rate is taken as it is; a resolution
+    /// larger than any rate leaves the drive to the model alone (no upper bound is needed).
     pub rate_resolution_mps: T,
 }
 
@@ -119,13 +120,6 @@ impl<T: Real> ProtectionConfig<T> {
             self.rate_resolution_mps,
             T::ZERO,
         )?;
-        if self.rate_resolution_mps > T::from_f64(MAX_PLAUSIBLE_TENSION_N) {
-            return Err(ConfigError::new(
-                "protection.rate_resolution_mps",
-                self.rate_resolution_mps,
-                Rule::TooLarge,
-            ));
-        }
         if self.max_tension_n > T::from_f64(MAX_PLAUSIBLE_TENSION_N) {
             return Err(ConfigError::new(
                 "protection.max_tension_n",
