@@ -606,6 +606,30 @@ fn j2_regresses_the_node_at_the_secular_rate() {
     );
 }
 
+/// Environment: a circular orbit with J2 on stays circular. On the equator the oblate field's
+/// radial pull is the same all round the circle, so a circular orbit exists, at the speed
+/// √((μ/a)(1 + (3/2) J2 (R_e/a)²)); the plant starts on it. Started at the Keplerian √(μ/a)
+/// instead, it would swing ±9 km in radius once an orbit (e ≈ 1.3e-3 at 700 km), and the
+/// libration that forces would move a 30 km keep by ±20 m (paper-elastic with J2 did).
+#[test]
+fn a_circular_orbit_with_j2_stays_circular() {
+    let mut prm = params(1e4);
+    prm.environment.j2 = true;
+    let mut p = ElasticPlant::new(prm, at_rest(100.0)).unwrap();
+    let orbit = 2.0 * std::f64::consts::PI / mean_motion();
+    let steps = (3.0 * orbit / 10.0).round() as usize;
+    let dt = 3.0 * orbit / steps as f64;
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0_f64);
+    for _ in 0..steps {
+        p.step(0.0, dt).unwrap();
+        let r = p.centre_of_mass_state().0.norm();
+        lo = lo.min(r);
+        hi = hi.max(r);
+    }
+    println!("J2, equator, three orbits: radius {lo:.3} … {hi:.3} m");
+    assert!(hi - lo < 50.0, "radius swings by {} m", hi - lo);
+}
+
 /// Environment: drag takes energy out of the orbit (at 300 km, with 1 m² of C_d·A on the
 /// sub-satellite, the centre of mass's specific orbital energy falls), and does nothing with
 /// the atmosphere off.

@@ -626,7 +626,7 @@ impl ElasticPlant {
             true,
             "finite",
         )?;
-        let (r_c, v_c) = orbit_state(&p.orbit);
+        let (r_c, v_c) = orbit_state(&p.orbit, &p.environment);
         let (e_r, e_th, e_h) = orbit_frame(&r_c, &v_c);
         let theta_rate = r_c.cross(&v_c).norm() / r_c.norm_squared();
         let (sa, ca) = init.alpha_rad.sin_cos();
@@ -1414,15 +1414,31 @@ fn plane_basis(inclination_rad: f64) -> (Vec3, Vec3) {
     (Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, ci, si))
 }
 
-/// Position and velocity on the orbit at its initial true anomaly (Keplerian).
-fn orbit_state(o: &OrbitParams) -> (Vec3, Vec3) {
+/// Position and velocity on the orbit at its initial true anomaly: Keplerian, except that a
+/// circular orbit (e = 0) with J2 on starts at the circular speed of the oblate field, so that
+/// it stays circular as the scenario says. At the Keplerian speed √(μ/a) the J2 field's extra
+/// pull, (3/2) J2 (R_e/a)² of the point mass's on the equator, would make it an orbit of
+/// e ≈ 1.3e-3 at 700 km (a ±9 km radius swing once an orbit), which forces a libration of the
+/// same order (docs/equations.md §16) that a controller told e = 0 cannot know: the 30 km keep
+/// moved by ±20 m. The speed balances the orbit-averaged radial gravity,
+/// v² = (μ/a) (1 + (3/2) J2 (R_e/a)² (1 − (3/2) sin² i)): exact on the equator (the radial
+/// J2 pull is then constant round the circle), first order in J2 on an inclined orbit, whose
+/// radial pull varies with latitude.
+fn orbit_state(o: &OrbitParams, env: &Environment) -> (Vec3, Vec3) {
     let (p_hat, q_hat) = plane_basis(o.inclination_rad);
     let a = o.orbit.semi_major_axis_m;
     let e = o.orbit.eccentricity;
     let semi_latus = a * (1.0 - e * e);
     let (s, c) = o.initial_true_anomaly_rad.sin_cos();
     let r = semi_latus / (1.0 + e * c);
-    let v = (o.orbit.mu_m3ps2 / semi_latus).sqrt();
+    let oblate = if env.j2 && e == 0.0 {
+        let re_a = environment::EARTH_EQUATORIAL_RADIUS_M / a;
+        let si = o.inclination_rad.sin();
+        1.0 + 1.5 * environment::EARTH_J2 * re_a * re_a * (1.0 - 1.5 * si * si)
+    } else {
+        1.0
+    };
+    let v = (o.orbit.mu_m3ps2 / semi_latus * oblate).sqrt();
     (
         (p_hat * c + q_hat * s) * r,
         (p_hat * (-s) + q_hat * (e + c)) * v,
