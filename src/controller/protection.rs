@@ -437,19 +437,23 @@ impl<T: Real> Protection<T> {
         }
     }
 
-    /// The free-tension estimate of this step: the model corrected by the load cell's mean
-    /// residual, if the load cell gave a plausible sample now (N). With a stale model (the law
-    /// did not run: coast, safe hold) the correction is used as it stands, not updated.
+    /// The free-tension estimate of this step, if the load cell gave a plausible sample now
+    /// (N): the model corrected by the load cell's mean residual. With a stale model (the law
+    /// did not run: safe hold) the load cell's own measure of it, T_meas + m_r l̈_now: the last
+    /// model no longer describes the state, and a stale estimate below T_min wound the reel in
+    /// at a constant acceleration for as long as the hold lasted (docs/equations.md §16.7: at
+    /// e = 0.3 from the 2 km keep to docking). The correction is not updated then.
     fn free_tension_n(&mut self, tension_n: Option<T>, fresh_model: bool) -> Option<T> {
         let model_n = self.last_model_n?;
         let plausible = T::from_f64(MAX_PLAUSIBLE_TENSION_N);
         let t = tension_n.filter(|t| t.is_finite() && t.abs() <= plausible)?;
-        if fresh_model {
-            // The tension at zero drive acceleration, as measured, less the model's.
-            let residual = t + self.radial_kg * self.drive_accel_mps2 - model_n;
-            self.correction_n =
-                self.correction_n + self.filter_gain * (residual - self.correction_n);
+        // The tension at zero drive acceleration, as measured.
+        let measured_n = t + self.radial_kg * self.drive_accel_mps2;
+        if !fresh_model {
+            return Some(measured_n);
         }
+        let residual = measured_n - model_n;
+        self.correction_n = self.correction_n + self.filter_gain * (residual - self.correction_n);
         Some(model_n + self.correction_n)
     }
 }
@@ -573,6 +577,55 @@ mod tests {
             worst_wrong = worst_wrong.max((wrong / expect - 1.0).abs());
         }
         assert!(worst_wrong > 0.1, "{worst_wrong}");
+    }
+
+    /// In a hold (the law did not run, the model is stale) the free tension is the load
+    /// cell's: a model that last said "below T_min" does not keep winding the reel in while
+    /// the load cell reads a taut tether (it did, at a_hi < 0, for as long as the hold lasted).
+    #[test]
+    fn in_a_hold_the_free_tension_is_the_load_cells() {
+        let mut p = protection(0.0);
+        let m_r = p.radial_kg;
+        // The law's last step: a tether swung near the horizontal, free tension negative.
+        let swung = FreeTensionModel {
+            length_m: 2_000.0,
+            orbit_rate_radps: N,
+            gravity_gradient_per_s2: N * N,
+            alpha_rate_radps: -N,
+            cos_two_alpha: -1.0,
+        };
+        let stale = p.model_free_tension_n(&swung);
+        assert!(stale < 0.0, "{stale}");
+        let (_, a_hi) = p
+            .sample(stale)
+            .bounds(Some(&swung), 0.0, 1.0)
+            .tension_accel_mps2
+            .unwrap();
+        assert!(a_hi < 0.0);
+        // Then the hold: the load cell reads 0.5 N with the drive at rest, step after step.
+        for _ in 0..100 {
+            let (_, a_hi) = p
+                .sample(0.5)
+                .bounds(None, 0.0, 1.0)
+                .tension_accel_mps2
+                .unwrap();
+            assert!(
+                (a_hi - (0.5 - p.min_tension_n) / m_r).abs() < 1e-12,
+                "{a_hi}"
+            );
+        }
+        // And with the drive accelerating at 1 mm/s² when it read 0.4 N: 0.4 N + m_r × 1e-3.
+        p.drive_accel_mps2 = 1e-3;
+        let (_, a_hi) = p
+            .sample(0.4)
+            .bounds(None, 0.0, 1.0)
+            .tension_accel_mps2
+            .unwrap();
+        let free = 0.4 + m_r * 1e-3;
+        assert!(
+            (a_hi - (free - p.min_tension_n) / m_r).abs() < 1e-12,
+            "{a_hi}"
+        );
     }
 
     #[test]
