@@ -18,14 +18,15 @@
 //! T₀ is estimated by a complementary filter: its fast part is Eq. 5a's model at the law's
 //! state (θ̇, α, α̇, l; cos 2α and μ/R³ from the law: n² on a circular orbit, the orbit
 //! source's μ/R³ = θ̇²/(1 + e cos θ) on an eccentric one, docs/equations.md §16.7), its slow
-//! part the load cell's correction, the
-//! residual T_meas + m_r l̈_now − m_r G_model (l̈_now: the drive's acceleration when the
-//! tension was measured) low-passed over `tension_filter_s` from 0. The model follows G without
-//! lag; the load cell removes what the model misses (eccentricity, a mass error, an unmodelled
-//! drag) and its noise enters only through the slow correction: σ √(Δt/(2τ_f)), 1.2 mN for a
+//! part the load cell's correction, the residual T_meas + m_r l̈_now − m_r G_model (l̈_now: the
+//! drive's acceleration when the tension was measured) low-passed over `tension_filter_s` from
+//! 0. The model follows G without lag; the load cell removes what the model misses slowly (a
+//! mass error, an unmodelled drag: not an error with the orbit's period, hence μ/R³ in the
+//! model) and its noise enters only through the slow correction: σ √(Δt/(2τ_f)), 1.2 mN for a
 //! load cell of σ = 0.1 N and τ_f = 3600 s (a quarter hour's mean, 600 s, left 2.9 mN and let
 //! the tether go slack in 3 runs of 4 in the early deployment; 3600 s: 28 runs of 28 taut,
-//! the least tension 0.11 mN).
+//! the least tension 0.11 mN). While the law does not run (coast, safe hold) the estimate is
+//! the load cell's own, T_meas + m_r l̈_now.
 //! Without a tension sample (`Input::tension_n` None, or implausible) there is no
 //! tension bound at that step: the command is today's envelope.
 //!
@@ -439,10 +440,11 @@ impl<T: Real> Protection<T> {
 
     /// The free-tension estimate of this step, if the load cell gave a plausible sample now
     /// (N): the model corrected by the load cell's mean residual. With a stale model (the law
-    /// did not run: safe hold) the load cell's own measure of it, T_meas + m_r l̈_now: the last
-    /// model no longer describes the state, and a stale estimate below T_min wound the reel in
-    /// at a constant acceleration for as long as the hold lasted (docs/equations.md §16.7: at
-    /// e = 0.3 from the 2 km keep to docking). The correction is not updated then.
+    /// did not run: coast, safe hold) the load cell's own measure of it, T_meas + m_r l̈_now:
+    /// the last model no longer describes the state, and a stale estimate below T_min wound
+    /// the reel in at a constant acceleration for as long as the hold lasted
+    /// (docs/equations.md §16.7: at e = 0.3 from the 2 km keep to docking). The correction is
+    /// not updated then.
     fn free_tension_n(&mut self, tension_n: Option<T>, fresh_model: bool) -> Option<T> {
         let model_n = self.last_model_n?;
         let plausible = T::from_f64(MAX_PLAUSIBLE_TENSION_N);
