@@ -16,14 +16,17 @@
 //! ```
 //!
 //! T₀ is estimated by a complementary filter: its fast part is Eq. 5a's model at the law's
-//! state (n, α, α̇, l; cos 2α from the law), its slow part the load cell's correction, the
-//! residual T_meas + m_r l̈_now − m_r G_model (l̈_now: the drive's acceleration when the
-//! tension was measured) low-passed over `tension_filter_s` from 0. The model follows G without
-//! lag; the load cell removes what the model misses (eccentricity, a mass error, an unmodelled
-//! drag) and its noise enters only through the slow correction: σ √(Δt/(2τ_f)), 1.2 mN for a
+//! state (θ̇, α, α̇, l; cos 2α and μ/R³ from the law: n² on a circular orbit, the orbit
+//! source's μ/R³ = θ̇²/(1 + e cos θ) on an eccentric one, docs/equations.md §16.7), its slow
+//! part the load cell's correction, the residual T_meas + m_r l̈_now − m_r G_model (l̈_now: the
+//! drive's acceleration when the tension was measured) low-passed over `tension_filter_s` from
+//! 0. The model follows G without lag; the load cell removes what the model misses slowly (a
+//! mass error, an unmodelled drag: not an error with the orbit's period, hence μ/R³ in the
+//! model) and its noise enters only through the slow correction: σ √(Δt/(2τ_f)), 1.2 mN for a
 //! load cell of σ = 0.1 N and τ_f = 3600 s (a quarter hour's mean, 600 s, left 2.9 mN and let
 //! the tether go slack in 3 runs of 4 in the early deployment; 3600 s: 28 runs of 28 taut,
-//! the least tension 0.11 mN).
+//! the least tension 0.11 mN). While the law does not run (coast, safe hold) the estimate is
+//! the load cell's own, T_meas + m_r l̈_now.
 //! Without a tension sample (`Input::tension_n` None, or implausible) there is no
 //! tension bound at that step: the command is today's envelope.
 //!
@@ -175,6 +178,9 @@ pub(crate) struct FreeTensionModel<T> {
     pub(crate) length_m: T,
     /// n (θ̇), rad/s.
     pub(crate) orbit_rate_radps: T,
+    /// μ/R³, 1/s²: n² on a circular orbit, θ̇²/(1 + e cos θ) on an eccentric one (from the
+    /// law's [`crate::law::OrbitForcing`], docs/equations.md §16.3).
+    pub(crate) gravity_gradient_per_s2: T,
     /// α̇ the law flies on, rad/s.
     pub(crate) alpha_rate_radps: T,
     /// cos 2α (the law's).
@@ -182,11 +188,18 @@ pub(crate) struct FreeTensionModel<T> {
 }
 
 impl<T: Real> FreeTensionModel<T> {
-    /// The state the law solved for.
+    /// The state the law solved for. μ/R³ is the law's: n² on a circular orbit (θ̇² would be
+    /// wrong by the factor 1 + e cos θ on an eccentric one, ±30 % at e = 0.3).
     pub(crate) fn of(x: &crate::law::LawInput<T>, s: &crate::law::LawOutput<T>) -> Self {
+        let n = x.orbit_rate_radps;
         Self {
             length_m: x.length_m,
-            orbit_rate_radps: x.orbit_rate_radps,
+            orbit_rate_radps: n,
+            gravity_gradient_per_s2: match &x.orbit {
+                // The law's 1.5 μ/R³.
+                Some(o) => o.gradient_per_s2 * T::from_f64(2.0 / 3.0),
+                None => n * n,
+            },
             alpha_rate_radps: x.alpha_rate_radps,
             cos_two_alpha: s.cos_two_alpha,
         }
@@ -381,8 +394,8 @@ impl<T: Real> Protection<T> {
         };
         if let Some(m) = model {
             self.last_model_n = Some(self.model_free_tension_n(m));
-            let n2l = m.orbit_rate_radps * m.orbit_rate_radps * m.length_m;
-            let short = T::from_f64(3.0 * MARGIN_OF_GRAVITY_GRADIENT) * self.radial_kg * n2l;
+            let gradient_l = m.gravity_gradient_per_s2 * m.length_m;
+            let short = T::from_f64(3.0 * MARGIN_OF_GRAVITY_GRADIENT) * self.radial_kg * gradient_l;
             self.min_tension_n = self.cfg.min_tension_n.min(short);
         }
         let tension_n = self.tension_sample_n.take();
@@ -408,10 +421,10 @@ impl<T: Real> Protection<T> {
     /// Eq. 5a's free tension m_r G of the model at the law's state, N.
     fn model_free_tension_n(&mut self, m: &FreeTensionModel<T>) -> T {
         let l = m.length_m;
-        let n = m.orbit_rate_radps;
-        let spin = n + m.alpha_rate_radps;
-        // 3 cos²α − 1 = ½ + (3/2) cos 2α.
-        let gradient = n * n * (T::from_f64(0.5) + T::from_f64(1.5) * m.cos_two_alpha);
+        let spin = m.orbit_rate_radps + m.alpha_rate_radps;
+        // (μ/R³)(3 cos²α − 1), 3 cos²α − 1 = ½ + (3/2) cos 2α.
+        let gradient =
+            m.gravity_gradient_per_s2 * (T::from_f64(0.5) + T::from_f64(1.5) * m.cos_two_alpha);
         let field = spin * spin + gradient;
         if self.masses.tether_density_kg_per_m == T::ZERO {
             // μ1 = 0, μ2 = 1.
@@ -425,19 +438,24 @@ impl<T: Real> Protection<T> {
         }
     }
 
-    /// The free-tension estimate of this step: the model corrected by the load cell's mean
-    /// residual, if the load cell gave a plausible sample now (N). With a stale model (the law
-    /// did not run: coast, safe hold) the correction is used as it stands, not updated.
+    /// The free-tension estimate of this step, if the load cell gave a plausible sample now
+    /// (N): the model corrected by the load cell's mean residual. With a stale model (the law
+    /// did not run: coast, safe hold) the load cell's own measure of it, T_meas + m_r l̈_now:
+    /// the last model no longer describes the state, and a stale estimate below T_min wound
+    /// the reel in at a constant acceleration for as long as the hold lasted
+    /// (docs/equations.md §16.7: at e = 0.3 from the 2 km keep to docking). The correction is
+    /// not updated then.
     fn free_tension_n(&mut self, tension_n: Option<T>, fresh_model: bool) -> Option<T> {
         let model_n = self.last_model_n?;
         let plausible = T::from_f64(MAX_PLAUSIBLE_TENSION_N);
         let t = tension_n.filter(|t| t.is_finite() && t.abs() <= plausible)?;
-        if fresh_model {
-            // The tension at zero drive acceleration, as measured, less the model's.
-            let residual = t + self.radial_kg * self.drive_accel_mps2 - model_n;
-            self.correction_n =
-                self.correction_n + self.filter_gain * (residual - self.correction_n);
+        // The tension at zero drive acceleration, as measured.
+        let measured_n = t + self.radial_kg * self.drive_accel_mps2;
+        if !fresh_model {
+            return Some(measured_n);
         }
+        let residual = measured_n - model_n;
+        self.correction_n = self.correction_n + self.filter_gain * (residual - self.correction_n);
         Some(model_n + self.correction_n)
     }
 }
@@ -478,6 +496,7 @@ mod tests {
         FreeTensionModel {
             length_m,
             orbit_rate_radps: N,
+            gravity_gradient_per_s2: N * N,
             alpha_rate_radps: 0.0,
             cos_two_alpha: 1.0,
         }
@@ -496,6 +515,117 @@ mod tests {
         let (_, a_hi) = b.tension_accel_mps2.unwrap();
         assert!(
             (a_hi - (expect * (1.0 - k) - 2e-3) / m_r).abs() < 1e-12,
+            "{a_hi}"
+        );
+    }
+
+    /// On an eccentric orbit the model's gravity gradient is the law's μ/R³ (θ̇²/(1 + e cos θ)),
+    /// not θ̇²: the free tension is Eq. 5a evaluated directly, μ/R³ from the orbit's radius,
+    /// around the orbit at e = 0.3 (with θ̇² it erred by up to 15 % of the tension at 20 km).
+    #[test]
+    fn on_an_eccentric_orbit_the_free_tension_is_eq_5a_with_mu_over_r_cubed() {
+        use crate::law::{solve, Blend, Gains, LawInput};
+        use crate::orbit::Orbit;
+        use crate::schedule::{LibratingReference, RefAngle, Reference};
+        let orbit = Orbit::<f64>::elliptic(10.0e6, 0.3);
+        let librating = LibratingReference::new(&orbit).unwrap();
+        let mut p = protection(0.0);
+        let m_r = p.radial_kg;
+        let (l, alpha, alpha_rate) = (20_000.0, 0.3_f64, 2.0e-4);
+        let mut worst_wrong: f64 = 0.0;
+        for theta in [0.0, 1.0, 2.0, core::f64::consts::PI, 4.0, 5.5] {
+            let base = Reference {
+                angle: RefAngle {
+                    angle_rad: 0.2,
+                    slope_rad_per_m: 0.0,
+                    curvature_rad_per_m2: 0.0,
+                },
+                time_rate_radps: 0.0,
+                slewing: false,
+                orbit: None,
+            };
+            let r = librating.eval(base, theta);
+            let rate = orbit.true_anomaly_rate_radps(theta);
+            let x = LawInput {
+                length_m: l,
+                alpha_rad: alpha,
+                alpha_rate_radps: alpha_rate,
+                orbit_rate_radps: rate,
+                orbit: r.orbit,
+                ref_angle_rad: r.angle.angle_rad,
+                ref_slope_rad_per_m: r.angle.slope_rad_per_m,
+                ref_curvature_rad_per_m2: r.angle.curvature_rad_per_m2,
+                ref_time_rate_radps: r.time_rate_radps,
+                mu3: 0.0,
+                mu3_per_m: 0.0,
+                blend: Blend::from_weight(0.0),
+                decay_rate_per_s: 5e-4,
+                initial_rate_mps: 0.0,
+                gains: Gains::paper(),
+            };
+            let s = solve(&x).unwrap();
+            let free = p.model_free_tension_n(&FreeTensionModel::of(&x, &s));
+            // Eq. 5a at l̈ = 0, β = 0, a massless tether (μ1 = 0, μ2 = 1), R from the orbit.
+            let e = orbit.eccentricity;
+            let radius = orbit.semi_major_axis_m * (1.0 - e * e) / (1.0 + e * theta.cos());
+            let mu_over_r3 = orbit.mu_m3ps2 / radius.powi(3);
+            let gradient = 3.0 * alpha.cos().powi(2) - 1.0;
+            let expect = m_r * l * ((rate + alpha_rate).powi(2) + mu_over_r3 * gradient);
+            assert!(
+                (free - expect).abs() < 1e-12 * expect,
+                "θ = {theta}: {free} vs {expect}"
+            );
+            let wrong = m_r * l * ((rate + alpha_rate).powi(2) + rate * rate * gradient);
+            worst_wrong = worst_wrong.max((wrong / expect - 1.0).abs());
+        }
+        assert!(worst_wrong > 0.1, "{worst_wrong}");
+    }
+
+    /// In a hold (the law did not run, the model is stale) the free tension is the load
+    /// cell's: a model that last said "below T_min" does not keep winding the reel in while
+    /// the load cell reads a taut tether (it did, at a_hi < 0, for as long as the hold lasted).
+    #[test]
+    fn in_a_hold_the_free_tension_is_the_load_cells() {
+        let mut p = protection(0.0);
+        let m_r = p.radial_kg;
+        // The law's last step: a tether swung near the horizontal, free tension negative.
+        let swung = FreeTensionModel {
+            length_m: 2_000.0,
+            orbit_rate_radps: N,
+            gravity_gradient_per_s2: N * N,
+            alpha_rate_radps: -N,
+            cos_two_alpha: -1.0,
+        };
+        let stale = p.model_free_tension_n(&swung);
+        assert!(stale < 0.0, "{stale}");
+        let (_, a_hi) = p
+            .sample(stale)
+            .bounds(Some(&swung), 0.0, 1.0)
+            .tension_accel_mps2
+            .unwrap();
+        assert!(a_hi < 0.0);
+        // Then the hold: the load cell reads 0.5 N with the drive at rest, step after step.
+        for _ in 0..100 {
+            let (_, a_hi) = p
+                .sample(0.5)
+                .bounds(None, 0.0, 1.0)
+                .tension_accel_mps2
+                .unwrap();
+            assert!(
+                (a_hi - (0.5 - p.min_tension_n) / m_r).abs() < 1e-12,
+                "{a_hi}"
+            );
+        }
+        // And with the drive accelerating at 1 mm/s² when it read 0.4 N: 0.4 N + m_r × 1e-3.
+        p.drive_accel_mps2 = 1e-3;
+        let (_, a_hi) = p
+            .sample(0.4)
+            .bounds(None, 0.0, 1.0)
+            .tension_accel_mps2
+            .unwrap();
+        let free = 0.4 + m_r * 1e-3;
+        assert!(
+            (a_hi - (free - p.min_tension_n) / m_r).abs() < 1e-12,
             "{a_hi}"
         );
     }
@@ -583,6 +713,7 @@ mod tests {
         let at_45 = FreeTensionModel {
             length_m: 5.0,
             orbit_rate_radps: N,
+            gravity_gradient_per_s2: N * N,
             alpha_rate_radps: 0.0,
             cos_two_alpha: 0.0,
         };
