@@ -129,20 +129,16 @@ impl<T: Real> Estimation<T> {
         self.filter.estimate()
     }
 
-    /// The law computed sin 2α and cos 2α for `alpha_rad` (the estimate's α̂): the next
-    /// prediction reuses them.
-    pub(super) fn lend_sin_cos_two_alpha(&mut self, alpha_rad: T, sin: T, cos: T) {
-        self.filter.lend_sin_cos_two_alpha(alpha_rad, sin, cos);
-    }
-
-    /// The NIS of the last step's α sample, if one met the estimate.
-    pub(super) fn nis(&self) -> Option<T> {
-        self.nis
-    }
-
-    /// This step commanded `c` for the coming period.
-    pub(super) fn commanded(&mut self, c: Commanded<T>) {
+    /// The end of a step: it commanded `c` for the coming period (the drive of the next
+    /// prediction), and the law, when it ran, computed sin 2α and cos 2α (`law_trig`: α, sin 2α,
+    /// cos 2α) for an α that the next prediction reuses them for if it is the estimate's α̂.
+    /// Returns the NIS of this step's α sample, if one met the estimate (for the output).
+    pub(super) fn end_step(&mut self, c: Commanded<T>, law_trig: Option<(T, T, T)>) -> Option<T> {
         self.commanded = Some(c);
+        if let Some((alpha_rad, sin, cos)) = law_trig {
+            self.filter.lend_sin_cos_two_alpha(alpha_rad, sin, cos);
+        }
+        self.nis
     }
 
     /// One step: carries the estimate over the `periods` that passed since the last step
@@ -338,12 +334,13 @@ mod tests {
         let mut e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), RATES).unwrap();
         assert_eq!(e.drive(0, None), None);
         e.orbit = Some(e.orbit_terms(1.06e-3, 0.0));
-        e.commanded(Commanded {
+        let c = Commanded {
             length_m: 100.0,
             rate_mps: 2.0,
             accel_mps2: 0.1,
             mu3: 0.01,
-        });
+        };
+        assert_eq!(e.end_step(c, None), None);
         let d = e.drive(0, None).unwrap();
         assert_eq!(
             (d.length_m, d.rate_mps, d.accel_mps2, d.mu3),

@@ -372,9 +372,6 @@ impl<T: Real> Controller<T> {
                 }
             };
         self.health.usable(&mut flags);
-        if let Some(est) = &mut self.estimation {
-            est.lend_sin_cos_two_alpha(alpha_rad, law.sin_two_alpha, law.cos_two_alpha);
-        }
 
         // The envelope. The acceleration limit holds per command: a command differs from the
         // previous one by at most a·Δt, whatever the calls' pattern (a gap of n ticks does
@@ -415,6 +412,8 @@ impl<T: Real> Controller<T> {
             .normalised_rate_at_reduced_length(law.reduced_length_m, rate);
         let margin = self.equilibrium_margin(x_rate);
         flags.set_if(margin < T::ZERO, Flags::NO_EQUILIBRIUM);
+        let law_trig = (alpha_rad, law.sin_two_alpha, law.cos_two_alpha);
+        let nis = self.commanded(x.length_m, accel, mu3, Some(law_trig));
         self.out = Output {
             tick,
             phase: self.sequencer.phase(),
@@ -429,11 +428,10 @@ impl<T: Real> Controller<T> {
             delta_rate_radps: law.delta_rate_radps,
             length_estimate_m: x.length_m,
             equilibrium_margin: margin,
-            nis: self.estimation.as_ref().and_then(Estimation::nis),
+            nis,
             flags,
             fault: None,
         };
-        self.commanded(x.length_m, accel, mu3);
     }
 
     /// The α and α̇ the law flies on: the sensed ones, or the estimate carried over the
@@ -471,16 +469,28 @@ impl<T: Real> Controller<T> {
         }
     }
 
-    /// Flying on the estimator: the command of this step, the drive of the next prediction
-    /// (the reel at `length_m`, at the kept command, accelerating at `accel_mps2`).
-    fn commanded(&mut self, length_m: T, accel_mps2: T, mu3: T) {
-        if let Some(est) = &mut self.estimation {
-            est.commanded(Commanded {
-                length_m,
-                rate_mps: self.last_rate_cmd_mps,
-                accel_mps2,
-                mu3,
-            });
+    /// Flying on the estimator, the end of its step: the command of this step, the drive of
+    /// the next prediction (the reel at `length_m`, at the kept command, accelerating at
+    /// `accel_mps2`), and the law's sin and cos 2α when it ran (`law_trig`, see
+    /// `Estimation::end_step`). Returns the NIS of this step's α sample for the output.
+    // One test for the estimator at the end of the step, where there were three (the lend
+    // after the law, the NIS for the output, the command after it).
+    fn commanded(
+        &mut self,
+        length_m: T,
+        accel_mps2: T,
+        mu3: T,
+        law_trig: Option<(T, T, T)>,
+    ) -> Option<T> {
+        let c = Commanded {
+            length_m,
+            rate_mps: self.last_rate_cmd_mps,
+            accel_mps2,
+            mu3,
+        };
+        match &mut self.estimation {
+            Some(est) => est.end_step(c, law_trig),
+            None => None,
         }
     }
 
@@ -557,6 +567,7 @@ impl<T: Real> Controller<T> {
         let accel_mps2 = (rate - previous) / dt;
         let margin = self.equilibrium_margin(x_rate);
         flags.set_if(margin < T::ZERO, Flags::NO_EQUILIBRIUM);
+        let nis = self.commanded(length_m, accel_mps2, mu3, None);
         self.out = Output {
             tick,
             phase: self.sequencer.phase(),
@@ -571,11 +582,10 @@ impl<T: Real> Controller<T> {
             delta_rate_radps: T::ZERO,
             length_estimate_m: length_m,
             equilibrium_margin: margin,
-            nis: self.estimation.as_ref().and_then(Estimation::nis),
+            nis,
             flags,
             fault,
         };
-        self.commanded(length_m, accel_mps2, mu3);
     }
 
     /// The protection's bounds of this step (none without a protection), `model` the law's
