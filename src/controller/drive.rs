@@ -32,7 +32,6 @@ impl<T: Real> Controller<T> {
         drive: DriveFaults,
     ) -> Output<T> {
         let (health, phase) = (self.health.health(), self.sequencer.phase());
-        let tension_limited = self.out.flags.contains(Flags::TENSION_LIMITED);
         let sample = match drive.outer_reaction() {
             OuterReaction::Report => sample,
             OuterReaction::Degrade => None,
@@ -46,7 +45,7 @@ impl<T: Real> Controller<T> {
         self.out
             .flags
             .set_if(self.out.health != health, Flags::HEALTH_CHANGED);
-        self.record_events(health, phase, tension_limited);
+        self.record_events(health, phase);
         self.out
     }
 }

@@ -118,6 +118,8 @@ pub struct Controller<T: Real> {
     last_rate_cmd_mps: T,
     /// The fault of the last step (a fault is an event when it differs from the last).
     last_fault: Option<Fault>,
+    /// The last step's command was tension limited (the limit beginning is an event).
+    last_tension_limited: bool,
     events: EventRing,
     /// The last step's output ([`Controller::output`]).
     out: Output<T>,
@@ -173,6 +175,7 @@ impl<T: Real> Controller<T> {
                 * cfg.period_s,
             last_rate_cmd_mps: cfg.initial_rate_mps,
             last_fault: None,
+            last_tension_limited: false,
             events: EventRing::new(),
             out: Output {
                 tick: 0,
@@ -257,9 +260,8 @@ impl<T: Real> Controller<T> {
     /// A step, then its events and the kept output.
     fn run(&mut self, tick: u32, sample: Option<&Input<T>>) -> Output<T> {
         let (health, phase) = (self.health.health(), self.sequencer.phase());
-        let tension_limited = self.out.flags.contains(Flags::TENSION_LIMITED);
         self.decide(tick, sample);
-        self.record_events(health, phase, tension_limited);
+        self.record_events(health, phase);
         self.out
     }
 
@@ -619,7 +621,7 @@ impl<T: Real> Controller<T> {
     // before it still in registers): 8 instructions less on the mission's worst step
     // (scripts/bench-target: 558 → 550).
     #[inline(always)]
-    fn record_events(&mut self, health: Health, phase: Phase, tension_limited: bool) {
+    fn record_events(&mut self, health: Health, phase: Phase) {
         let out = &self.out;
         let tick = out.tick;
         if out.health != health {
@@ -644,9 +646,60 @@ impl<T: Real> Controller<T> {
             let kind = EventKind::BlendRestart;
             self.events.push(Event { tick, kind });
         }
-        if out.flags.contains(Flags::TENSION_LIMITED) && !tension_limited {
+        let tension_limited = out.flags.contains(Flags::TENSION_LIMITED);
+        if tension_limited && !self.last_tension_limited {
             let kind = EventKind::TensionLimited;
             self.events.push(Event { tick, kind });
         }
+        self.last_tension_limited = tension_limited;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The paper's stage 1 at `tick` with the load cell reading `tension_n`.
+    fn sample(tick: u32, tension_n: Option<f64>) -> Input<f64> {
+        Input {
+            tick,
+            length_m: 1.0 + 0.1 * f64::from(tick),
+            reel_rate_mps: None,
+            tension_n,
+            alpha_rad: Some(-35.0_f64.to_radians()),
+            alpha_rate_radps: Some(0.0),
+            orbit_rate_radps: 1.0602e-3,
+            true_anomaly_rad: 0.0,
+        }
+    }
+
+    #[test]
+    fn the_tension_limit_is_an_event_each_time_it_begins() {
+        // A load cell the protection follows within a period, and a low tension limit.
+        let protection = ProtectionConfig {
+            max_tension_n: 0.5,
+            tension_filter_s: 1.0,
+            ..ProtectionConfig::default_for_period()
+        };
+        let cfg = Config {
+            protection: Some(protection),
+            ..Config::<f64>::paper()
+        };
+        let mut ctl = Controller::new(cfg).unwrap();
+        // Inside the window, above it (limited), no reading (no tension bound), above it again.
+        let (ok, over) = (Some(0.1), Some(5.0));
+        let tensions = [ok, ok, over, over, over, None, None, over, over];
+        let mut limited = [false; 9];
+        let mut began = [false; 9];
+        for (tick, &t) in (0u32..).zip(&tensions) {
+            let out = ctl.step(&sample(tick, t));
+            limited[tick as usize] = out.flags.contains(Flags::TENSION_LIMITED);
+            while let Some(e) = ctl.pop_event() {
+                began[tick as usize] |= e.kind == EventKind::TensionLimited;
+            }
+        }
+        let (f, t) = (false, true);
+        assert_eq!(limited, [f, f, t, t, t, f, f, t, t]);
+        assert_eq!(began, [f, f, t, f, f, f, f, t, f]);
     }
 }
