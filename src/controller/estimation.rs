@@ -129,15 +129,17 @@ impl<T: Real> Estimation<T> {
         self.filter.estimate()
     }
 
+    /// The law computed sin 2α and cos 2α for `alpha_rad` (the estimate's α̂): the next
+    /// prediction reuses them.
+    pub(super) fn lend_sin_cos_two_alpha(&mut self, alpha_rad: T, sin: T, cos: T) {
+        self.filter.lend_sin_cos_two_alpha(alpha_rad, sin, cos);
+    }
+
     /// The end of a step: it commanded `c` for the coming period (the drive of the next
-    /// prediction), and the law, when it ran, computed sin 2α and cos 2α (`law_trig`: α, sin 2α,
-    /// cos 2α) for an α that the next prediction reuses them for if it is the estimate's α̂.
-    /// Returns the NIS of this step's α sample, if one met the estimate (for the output).
-    pub(super) fn end_step(&mut self, c: Commanded<T>, law_trig: Option<(T, T, T)>) -> Option<T> {
+    /// prediction). Returns the NIS of this step's α sample, if one met the estimate (for the
+    /// output).
+    pub(super) fn end_step(&mut self, c: Commanded<T>) -> Option<T> {
         self.commanded = Some(c);
-        if let Some((alpha_rad, sin, cos)) = law_trig {
-            self.filter.lend_sin_cos_two_alpha(alpha_rad, sin, cos);
-        }
         self.nis
     }
 
@@ -340,7 +342,7 @@ mod tests {
             accel_mps2: 0.1,
             mu3: 0.01,
         };
-        assert_eq!(e.end_step(c, None), None);
+        assert_eq!(e.end_step(c), None);
         let d = e.drive(0, None).unwrap();
         assert_eq!(
             (d.length_m, d.rate_mps, d.accel_mps2, d.mu3),

@@ -379,6 +379,9 @@ impl<T: Real> Controller<T> {
                 }
             };
         self.health.usable(&mut flags);
+        if let Some(est) = &mut self.estimation {
+            est.lend_sin_cos_two_alpha(alpha_rad, law.sin_two_alpha, law.cos_two_alpha);
+        }
 
         // The envelope. The acceleration limit holds per command: a command differs from the
         // previous one by at most a·Δt, whatever the calls' pattern (a gap of n ticks does
@@ -419,8 +422,7 @@ impl<T: Real> Controller<T> {
             .normalised_rate_at_reduced_length(law.reduced_length_m, rate);
         let margin = self.equilibrium_margin(x_rate);
         flags.set_if(margin < T::ZERO, Flags::NO_EQUILIBRIUM);
-        let law_trig = (alpha_rad, law.sin_two_alpha, law.cos_two_alpha);
-        let nis = self.commanded(x.length_m, accel, mu3, Some(law_trig));
+        let nis = self.commanded(x.length_m, accel, mu3);
         self.out = Output {
             tick,
             phase: self.sequencer.phase(),
@@ -478,17 +480,12 @@ impl<T: Real> Controller<T> {
 
     /// Flying on the estimator, the end of its step: the command of this step, the drive of
     /// the next prediction (the reel at `length_m`, at the kept command, accelerating at
-    /// `accel_mps2`), and the law's sin and cos 2α when it ran (`law_trig`, see
-    /// `Estimation::end_step`). Returns the NIS of this step's α sample for the output.
-    // One test for the estimator at the end of the step, where there were three (the lend
-    // after the law, the NIS for the output, the command after it).
-    fn commanded(
-        &mut self,
-        length_m: T,
-        accel_mps2: T,
-        mu3: T,
-        law_trig: Option<(T, T, T)>,
-    ) -> Option<T> {
+    /// `accel_mps2`). Returns the NIS of this step's α sample for the output.
+    // One test for the estimator for both, where there were two (the command after the output,
+    // the NIS for it): with the last step's health and phase kept as state, mission 905/935 →
+    // 900/928 (scripts/bench-target; the law's sin/cos 2α̂ lent at the end of the step as well
+    // took 5 more: they stayed live across the envelope).
+    fn commanded(&mut self, length_m: T, accel_mps2: T, mu3: T) -> Option<T> {
         let c = Commanded {
             length_m,
             rate_mps: self.last_rate_cmd_mps,
@@ -496,7 +493,7 @@ impl<T: Real> Controller<T> {
             mu3,
         };
         match &mut self.estimation {
-            Some(est) => est.end_step(c, law_trig),
+            Some(est) => est.end_step(c),
             None => None,
         }
     }
@@ -574,7 +571,7 @@ impl<T: Real> Controller<T> {
         let accel_mps2 = (rate - previous) / dt;
         let margin = self.equilibrium_margin(x_rate);
         flags.set_if(margin < T::ZERO, Flags::NO_EQUILIBRIUM);
-        let nis = self.commanded(length_m, accel_mps2, mu3, None);
+        let nis = self.commanded(length_m, accel_mps2, mu3);
         self.out = Output {
             tick,
             phase: self.sequencer.phase(),
