@@ -383,6 +383,24 @@ impl<T: Real> Controller<T> {
             est.lend_sin_cos_two_alpha(alpha_rad, law.sin_two_alpha, law.cos_two_alpha);
         }
 
+        // Sequence the mission: the phase after this step of the law, and its progress. Before
+        // the envelope, which neither reads nor changes them: the slew's flag is not carried
+        // across it (mission worst 928 → 920, scripts/bench-target).
+        flags.set_if(reference.slewing, Flags::SLEWING);
+        match self
+            .sequencer
+            .advance_phase(tick, x.length_m, reference.slewing)
+        {
+            Progress::OnTrack => {}
+            Progress::Stalled { first } => {
+                flags.set(Flags::NO_PROGRESS);
+                if first {
+                    let kind = EventKind::NoProgress(self.sequencer.phase());
+                    self.events.push(Event { tick, kind });
+                }
+            }
+        }
+
         // The envelope. The acceleration limit holds per command: a command differs from the
         // previous one by at most a·Δt, whatever the calls' pattern (a gap of n ticks does
         // not allow n·a·Δt: the reel ran at the previous command all along, and would step).
@@ -400,21 +418,7 @@ impl<T: Real> Controller<T> {
             }
         };
         flags.set(sat.0);
-        flags.set_if(reference.slewing, Flags::SLEWING);
         self.last_rate_cmd_mps = rate;
-        match self
-            .sequencer
-            .advance_phase(tick, x.length_m, reference.slewing)
-        {
-            Progress::OnTrack => {}
-            Progress::Stalled { first } => {
-                flags.set(Flags::NO_PROGRESS);
-                if first {
-                    let kind = EventKind::NoProgress(self.sequencer.phase());
-                    self.events.push(Event { tick, kind });
-                }
-            }
-        }
 
         // The output.
         let x_rate = self
