@@ -229,6 +229,27 @@ impl<T: Real> PreparedEnvelope<T> {
         (y.clamp_finite(-vmax, vmax), sat)
     }
 
+    /// The law's request limited ([`Self::limit_request`]) and the acceleration reported with
+    /// it ([`Self::commanded_accel`]): the command, its acceleration, and every limit that acted
+    /// on either.
+    // Inlined into its caller, which calls it once per kind of `bounds` (the controller: none,
+    // or the protection's), so that constant bounds cost nothing.
+    #[inline(always)]
+    pub(crate) fn limit_law(
+        &self,
+        requested_mps: T,
+        eq30_mps2: T,
+        previous_mps: T,
+        length_m: T,
+        dt_s: T,
+        bounds: &Bounds<T>,
+    ) -> (T, T, Saturation) {
+        let (rate, sat) = self.limit_request(requested_mps, previous_mps, length_m, dt_s, bounds);
+        let (accel, accel_sat) =
+            self.commanded_accel(eq30_mps2, rate, previous_mps, dt_s, sat, bounds);
+        (rate, accel, Saturation(sat.0 | accel_sat.0))
+    }
+
     /// The acceleration reported with a command `rate_mps` that followed `previous_mps`: a
     /// limited command's slope over the period; otherwise Eq. 30's `eq30_mps2`, bounded like
     /// every commanded quantity (Eq. 30 is the law's derivative, which leaves the envelope where

@@ -31,8 +31,7 @@ impl<T: Real> Controller<T> {
         sample: Option<&Input<T>>,
         drive: DriveFaults,
     ) -> Output<T> {
-        let (health, phase) = (self.health.health(), self.sequencer.phase());
-        let tension_limited = self.out.flags.contains(Flags::TENSION_LIMITED);
+        let health = self.health.health();
         let sample = match drive.outer_reaction() {
             OuterReaction::Report => sample,
             OuterReaction::Degrade => None,
@@ -46,7 +45,7 @@ impl<T: Real> Controller<T> {
         self.out
             .flags
             .set_if(self.out.health != health, Flags::HEALTH_CHANGED);
-        self.record_events(health, phase, tension_limited);
+        self.record_events();
         self.out
     }
 }

@@ -135,14 +135,12 @@ impl<T: Real> Estimation<T> {
         self.filter.lend_sin_cos_two_alpha(alpha_rad, sin, cos);
     }
 
-    /// The NIS of the last step's α sample, if one met the estimate.
-    pub(super) fn nis(&self) -> Option<T> {
-        self.nis
-    }
-
-    /// This step commanded `c` for the coming period.
-    pub(super) fn commanded(&mut self, c: Commanded<T>) {
+    /// The end of a step: it commanded `c` for the coming period (the drive of the next
+    /// prediction). Returns the NIS of this step's α sample, if one met the estimate (for the
+    /// output).
+    pub(super) fn end_step(&mut self, c: Commanded<T>) -> Option<T> {
         self.commanded = Some(c);
+        self.nis
     }
 
     /// One step: carries the estimate over the `periods` that passed since the last step
@@ -338,12 +336,13 @@ mod tests {
         let mut e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), RATES).unwrap();
         assert_eq!(e.drive(0, None), None);
         e.orbit = Some(e.orbit_terms(1.06e-3, 0.0));
-        e.commanded(Commanded {
+        let c = Commanded {
             length_m: 100.0,
             rate_mps: 2.0,
             accel_mps2: 0.1,
             mu3: 0.01,
-        });
+        };
+        assert_eq!(e.end_step(c), None);
         let d = e.drive(0, None).unwrap();
         assert_eq!(
             (d.length_m, d.rate_mps, d.accel_mps2, d.mu3),

@@ -68,7 +68,7 @@ mod sequencer;
 use crate::envelope::PreparedEnvelope;
 use crate::equilibrium::ExistenceMonitor;
 use crate::estimator::Estimate;
-use crate::law::{self, LawInput, LawOutput};
+use crate::law::{self, LawInput};
 use crate::monitor::{Monitor, Swing, SPOOL_MARGIN};
 use crate::real::Real;
 
@@ -116,8 +116,14 @@ pub struct Controller<T: Real> {
     safe_hold_step_mps: T,
     /// The command of the last step, m/s (l̇0 before the first).
     last_rate_cmd_mps: T,
+    /// The health of the last step (a change of health is an event).
+    last_health: Health,
+    /// The phase of the last step (a change of phase is an event).
+    last_phase: Phase,
     /// The fault of the last step (a fault is an event when it differs from the last).
     last_fault: Option<Fault>,
+    /// The last step's command was tension limited (the limit beginning is an event).
+    last_tension_limited: bool,
     events: EventRing,
     /// The last step's output ([`Controller::output`]).
     out: Output<T>,
@@ -172,7 +178,10 @@ impl<T: Real> Controller<T> {
                 .min(cfg.envelope.max_accel_mps2)
                 * cfg.period_s,
             last_rate_cmd_mps: cfg.initial_rate_mps,
+            last_health: Health::Nominal,
+            last_phase: Phase::Deploy,
             last_fault: None,
+            last_tension_limited: false,
             events: EventRing::new(),
             out: Output {
                 tick: 0,
@@ -256,10 +265,8 @@ impl<T: Real> Controller<T> {
 
     /// A step, then its events and the kept output.
     fn run(&mut self, tick: u32, sample: Option<&Input<T>>) -> Output<T> {
-        let (health, phase) = (self.health.health(), self.sequencer.phase());
-        let tension_limited = self.out.flags.contains(Flags::TENSION_LIMITED);
         self.decide(tick, sample);
-        self.record_events(health, phase, tension_limited);
+        self.record_events();
         self.out
     }
 
@@ -376,22 +383,10 @@ impl<T: Real> Controller<T> {
             est.lend_sin_cos_two_alpha(alpha_rad, law.sin_two_alpha, law.cos_two_alpha);
         }
 
-        // The envelope. The acceleration limit holds per command: a command differs from the
-        // previous one by at most a·Δt, whatever the calls' pattern (a gap of n ticks does
-        // not allow n·a·Δt: the reel ran at the previous command all along, and would step).
-        // The protection bounds it further by the tension the tether carries (and the drive).
-        let previous = self.last_rate_cmd_mps;
-        let bounds = self.bounds(Some((&law_in, &law)), previous);
-        let (rate, sat) =
-            self.envelope
-                .limit_request(law.rate_mps, previous, x.length_m, dt, &bounds);
-        flags.set(sat.0);
+        // Sequence the mission: the phase after this step of the law, and its progress. Before
+        // the envelope, which neither reads nor changes them: the slew's flag is not carried
+        // across it (mission worst 928 → 920, scripts/bench-target).
         flags.set_if(reference.slewing, Flags::SLEWING);
-        let (accel, accel_sat) = self
-            .envelope
-            .commanded_accel(accel_mps2, rate, previous, dt, sat, &bounds);
-        flags.set(accel_sat.0);
-        self.last_rate_cmd_mps = rate;
         match self
             .sequencer
             .advance_phase(tick, x.length_m, reference.slewing)
@@ -406,12 +401,32 @@ impl<T: Real> Controller<T> {
             }
         }
 
+        // The envelope. The acceleration limit holds per command: a command differs from the
+        // previous one by at most a·Δt, whatever the calls' pattern (a gap of n ticks does
+        // not allow n·a·Δt: the reel ran at the previous command all along, and would step).
+        // The protection bounds it further by the tension the tether carries (and the drive).
+        // One match on the protection, the envelope inlined into each arm: without one its
+        // bounds are constants, and cost the step nothing (scripts/bench-target, mission
+        // median 950 → 920, worst 980 → 948).
+        let previous = self.last_rate_cmd_mps;
+        let (env, l) = (&self.envelope, x.length_m);
+        let (rate, accel, sat) = match &mut self.protection {
+            None => env.limit_law(law.rate_mps, accel_mps2, previous, l, dt, &Bounds::none()),
+            Some(p) => {
+                let bounds = p.bounds(Some(&FreeTensionModel::of(&law_in, &law)), previous, dt);
+                env.limit_law(law.rate_mps, accel_mps2, previous, l, dt, &bounds)
+            }
+        };
+        flags.set(sat.0);
+        self.last_rate_cmd_mps = rate;
+
         // The output.
         let x_rate = self
             .existence
             .normalised_rate_at_reduced_length(law.reduced_length_m, rate);
         let margin = self.equilibrium_margin(x_rate);
         flags.set_if(margin < T::ZERO, Flags::NO_EQUILIBRIUM);
+        let nis = self.commanded(x.length_m, accel, mu3);
         self.out = Output {
             tick,
             phase: self.sequencer.phase(),
@@ -426,11 +441,10 @@ impl<T: Real> Controller<T> {
             delta_rate_radps: law.delta_rate_radps,
             length_estimate_m: x.length_m,
             equilibrium_margin: margin,
-            nis: self.estimation.as_ref().and_then(Estimation::nis),
+            nis,
             flags,
             fault: None,
         };
-        self.commanded(x.length_m, accel, mu3);
     }
 
     /// The α and α̇ the law flies on: the sensed ones, or the estimate carried over the
@@ -468,16 +482,23 @@ impl<T: Real> Controller<T> {
         }
     }
 
-    /// Flying on the estimator: the command of this step, the drive of the next prediction
-    /// (the reel at `length_m`, at the kept command, accelerating at `accel_mps2`).
-    fn commanded(&mut self, length_m: T, accel_mps2: T, mu3: T) {
-        if let Some(est) = &mut self.estimation {
-            est.commanded(Commanded {
-                length_m,
-                rate_mps: self.last_rate_cmd_mps,
-                accel_mps2,
-                mu3,
-            });
+    /// Flying on the estimator, the end of its step: the command of this step, the drive of
+    /// the next prediction (the reel at `length_m`, at the kept command, accelerating at
+    /// `accel_mps2`). Returns the NIS of this step's α sample for the output.
+    // One test for the estimator for both, where there were two (the command after the output,
+    // the NIS for it): with the last step's health and phase kept as state, mission 905/935 →
+    // 900/928 (scripts/bench-target; the law's sin/cos 2α̂ lent at the end of the step as well
+    // took 5 more: they stayed live across the envelope).
+    fn commanded(&mut self, length_m: T, accel_mps2: T, mu3: T) -> Option<T> {
+        let c = Commanded {
+            length_m,
+            rate_mps: self.last_rate_cmd_mps,
+            accel_mps2,
+            mu3,
+        };
+        match &mut self.estimation {
+            Some(est) => est.end_step(c),
+            None => None,
         }
     }
 
@@ -543,7 +564,7 @@ impl<T: Real> Controller<T> {
             }
         };
         let length_m = self.length.length_m().unwrap_or(T::ZERO);
-        let bounds = self.bounds(None, previous);
+        let bounds = self.hold_bounds(previous);
         let (rate, sat) = self
             .envelope
             .limit_request(target, previous, length_m, dt, &bounds);
@@ -554,6 +575,7 @@ impl<T: Real> Controller<T> {
         let accel_mps2 = (rate - previous) / dt;
         let margin = self.equilibrium_margin(x_rate);
         flags.set_if(margin < T::ZERO, Flags::NO_EQUILIBRIUM);
+        let nis = self.commanded(length_m, accel_mps2, mu3);
         self.out = Output {
             tick,
             phase: self.sequencer.phase(),
@@ -568,26 +590,18 @@ impl<T: Real> Controller<T> {
             delta_rate_radps: T::ZERO,
             length_estimate_m: length_m,
             equilibrium_margin: margin,
-            nis: self.estimation.as_ref().and_then(Estimation::nis),
+            nis,
             flags,
             fault,
         };
-        self.commanded(length_m, accel_mps2, mu3);
     }
 
-    /// The protection's bounds of this step (none without a protection), `law` the law's
-    /// input and solution when it ran (its free-tension model is built only with a protection).
-    // Inlined: out of line, the law's input and solution passed by reference had to be kept in
-    // memory for it (scripts/bench-target, flight configuration, mission median/worst: 1000/1030
-    // out of line, 930/960 inlined; main with the model built ahead of the match: 950/980).
-    #[inline(always)]
-    fn bounds(&mut self, law: Option<(&LawInput<T>, &LawOutput<T>)>, previous_mps: T) -> Bounds<T> {
+    /// The protection's bounds of a step in which the law did not run (a hold: the model is
+    /// stale, the free tension the load cell's own); none without a protection.
+    fn hold_bounds(&mut self, previous_mps: T) -> Bounds<T> {
         let dt = self.cfg.period_s;
         match &mut self.protection {
-            Some(p) => {
-                let model = law.map(|(x, s)| FreeTensionModel::of(x, s));
-                p.bounds(model.as_ref(), previous_mps, dt)
-            }
+            Some(p) => p.bounds(None, previous_mps, dt),
             None => Bounds::none(),
         }
     }
@@ -607,15 +621,20 @@ impl<T: Real> Controller<T> {
         }
     }
 
-    /// Records a step's events, in this order: health change, phase change, new fault, blend
-    /// restart. A quiet step (the common case) records nothing.
-    // Inlined into the step (a quiet step's checks without a call, and the health and phase
-    // before it still in registers): 8 instructions less on the mission's worst step
-    // (scripts/bench-target: 558 → 550).
+    /// Records a step's events, its changes against the last step, in this order: health
+    /// change, phase change, new fault, blend restart, the tension bound beginning to act. A
+    /// quiet step (the common case) records nothing.
+    // Inlined into the step (a quiet step's checks without a call): 8 instructions less on the
+    // mission's worst step (scripts/bench-target: 558 → 550). The last step's health and phase
+    // are kept in the controller, not snapshotted before the step and carried across it in
+    // registers (spilled around the law): mission 913/940 → 905/935.
     #[inline(always)]
-    fn record_events(&mut self, health: Health, phase: Phase, tension_limited: bool) {
+    fn record_events(&mut self) {
         let out = &self.out;
         let tick = out.tick;
+        let (health, phase) = (self.last_health, self.last_phase);
+        self.last_health = out.health;
+        self.last_phase = out.phase;
         if out.health != health {
             let kind = EventKind::Health {
                 from: health,
@@ -638,9 +657,60 @@ impl<T: Real> Controller<T> {
             let kind = EventKind::BlendRestart;
             self.events.push(Event { tick, kind });
         }
-        if out.flags.contains(Flags::TENSION_LIMITED) && !tension_limited {
+        let tension_limited = out.flags.contains(Flags::TENSION_LIMITED);
+        if tension_limited && !self.last_tension_limited {
             let kind = EventKind::TensionLimited;
             self.events.push(Event { tick, kind });
         }
+        self.last_tension_limited = tension_limited;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The paper's stage 1 at `tick` with the load cell reading `tension_n`.
+    fn sample(tick: u32, tension_n: Option<f64>) -> Input<f64> {
+        Input {
+            tick,
+            length_m: 1.0 + 0.1 * f64::from(tick),
+            reel_rate_mps: None,
+            tension_n,
+            alpha_rad: Some(-35.0_f64.to_radians()),
+            alpha_rate_radps: Some(0.0),
+            orbit_rate_radps: 1.0602e-3,
+            true_anomaly_rad: 0.0,
+        }
+    }
+
+    #[test]
+    fn the_tension_limit_is_an_event_each_time_it_begins() {
+        // A load cell the protection follows within a period, and a low tension limit.
+        let protection = ProtectionConfig {
+            max_tension_n: 0.5,
+            tension_filter_s: 1.0,
+            ..ProtectionConfig::default_for_period()
+        };
+        let cfg = Config {
+            protection: Some(protection),
+            ..Config::<f64>::paper()
+        };
+        let mut ctl = Controller::new(cfg).unwrap();
+        // Inside the window, above it (limited), no reading (no tension bound), above it again.
+        let (ok, over) = (Some(0.1), Some(5.0));
+        let tensions = [ok, ok, over, over, over, None, None, over, over];
+        let mut limited = [false; 9];
+        let mut began = [false; 9];
+        for (tick, &t) in (0u32..).zip(&tensions) {
+            let out = ctl.step(&sample(tick, t));
+            limited[tick as usize] = out.flags.contains(Flags::TENSION_LIMITED);
+            while let Some(e) = ctl.pop_event() {
+                began[tick as usize] |= e.kind == EventKind::TensionLimited;
+            }
+        }
+        let (f, t) = (false, true);
+        assert_eq!(limited, [f, f, t, t, t, f, f, t, t]);
+        assert_eq!(began, [f, f, t, f, f, f, f, t, f]);
     }
 }
