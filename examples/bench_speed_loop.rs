@@ -10,7 +10,11 @@
 //!    brake engaging at rest (20 000 ticks);
 //! 2. `faults`: a saturated 0.5 → 10 m/s step, a one-tick encoder jump, missing counts, bad
 //!    tension readings, a non-finite command, a jammed drum until the stall trip, a cleared
-//!    trip, a counter that lost counts for good until the encoder trip.
+//!    trip, a counter that lost counts for good until the encoder trip;
+//! 3. `worst`: every arm's worst path, the fault branches of one step together: encoder jumps
+//!    (one tick in three) and an overload tension on a jammed drum, through the stall's count
+//!    and trip, the tripped state, a brake release, the brake's rest count while the stall and
+//!    saturation counters run, and the encoder trip (6 000 ticks).
 //!
 //! Run it (after `scripts/setup`) with
 //!
@@ -113,6 +117,8 @@ mod bench {
         None,
         Command(f32, f32),
         Jam,
+        /// Jams the drum and commands (rate, acceleration) in the same tick.
+        JamAndCommand(f32, f32),
         ClearTrip,
     }
 
@@ -137,8 +143,15 @@ mod bench {
         };
         for tick in 0..ticks {
             let t = scenario(tick);
-            match t.action {
-                Action::None => {}
+            let action = match t.action {
+                Action::JamAndCommand(rate_mps, accel_mps2) => {
+                    drum.jammed = true;
+                    Action::Command(rate_mps, accel_mps2)
+                }
+                other => other,
+            };
+            match action {
+                Action::None | Action::JamAndCommand(..) => {}
                 Action::Command(rate_mps, accel_mps2) => {
                     let cmd = RateCommand {
                         rate_mps,
@@ -295,6 +308,33 @@ fn main() -> ! {
             // A counter that lost counts for good: jumps until the encoder trip.
             11_000.. => t.count_offset = 20_000,
             _ => {}
+        }
+        t
+    });
+    // Every arm's worst path: the fault branches of one step combined. A jammed drum under an
+    // overload (the reading clamped into range, a fault) and an encoder jump every third tick
+    // (rejected, its total predicted, no trip): a moving command until the stall trips (then
+    // tripped, with the same faults); cleared, back to normal tension; then a rest command on
+    // the jammed drum, so the brake counts its rest ticks while the stall and saturation
+    // counters run; cleared again; a counter that lost counts for good until the encoder trip,
+    // under the overload.
+    bench::measure(&meter, "worst", 6_000, |tick| {
+        let mut t = quiet(match tick {
+            0 => Action::Command(0.5, 0.0),
+            1000 => Action::Jam,
+            3000 => Action::JamAndCommand(0.0, -5.0),
+            2000 | 4000 => Action::ClearTrip,
+            _ => Action::None,
+        });
+        let overload = (1000..2000).contains(&tick) || (3000..4000).contains(&tick) || tick >= 5000;
+        if overload {
+            t.tension_n = Some(1e6);
+        }
+        if (1000..4000).contains(&tick) && tick % 3 == 0 {
+            t.count_offset = 20_000;
+        }
+        if tick >= 5000 {
+            t.count_offset = 20_000;
         }
         t
     });

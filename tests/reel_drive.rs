@@ -487,6 +487,31 @@ fn a_jammed_drum_trips_as_a_stall_after_half_a_second() {
 }
 
 #[test]
+fn a_drum_held_at_rest_against_the_tension_is_not_a_stall() {
+    // Commanded to rest, the drum still under 150 N (15 N m against a 5 N m motor: the duty
+    // saturates, the stall duty is reached) and jammed (no motion): the brake engages after
+    // its rest ticks, even when they outlast the stall ticks; no stall trip.
+    let mut cfg = DriveConfig::example();
+    cfg.brake.engage_ticks = 2 * cfg.faults.stall_ticks;
+    let mut run = settled_at(cfg, 0.5);
+    run.command(0.0, -5.0, false);
+    run.tension_n = 150.0;
+    run.drum.jammed = true;
+    let engaged_at = loop {
+        let out = run.tick();
+        assert!(
+            !out.faults.contains(DriveFault::MotorStall) && !matches!(out.brake, Brake::Tripped(_)),
+            "{out:?}"
+        );
+        if out.brake == Brake::Engaged {
+            break out.tick;
+        }
+        assert!(run.tick < 10_000, "never engaged");
+    };
+    assert!(engaged_at >= 2000 + cfg.brake.engage_ticks, "{engaged_at}");
+}
+
+#[test]
 fn a_drum_that_cannot_hold_the_tension_reports_saturation_but_is_not_stalled() {
     // 60 N pulls 6 N m out of a 5 N m motor: winding in at −1 m/s is impossible.
     let mut run = settled_at(DriveConfig::example(), 0.5);
@@ -610,7 +635,7 @@ fn every_invalid_parameter_is_named() {
     let ok = DriveConfig::example();
     assert_eq!(ok.validate(), Ok(()));
     type Breaker = fn(&mut DriveConfig);
-    let cases: [(&str, DriveRule, Breaker); 12] = [
+    let cases: [(&str, DriveRule, Breaker); 14] = [
         ("inner_rate_hz", DriveRule::BelowMinimum, |c| {
             c.inner_rate_hz = 50
         }),
@@ -645,6 +670,12 @@ fn every_invalid_parameter_is_named() {
         ),
         ("faults.stall_duty", DriveRule::OutOfRange, |c| {
             c.faults.stall_duty = 0.95
+        }),
+        ("brake.engage_ticks", DriveRule::OutOfRange, |c| {
+            c.brake.engage_ticks = 1 << 31
+        }),
+        ("faults.stall_ticks", DriveRule::OutOfRange, |c| {
+            c.faults.stall_ticks = u32::MAX
         }),
         ("faults.max_tension_n", DriveRule::BandInverted, |c| {
             c.faults.max_tension_n = -10.0

@@ -13,6 +13,12 @@ pub const SPEED_WINDOW_CAPACITY: usize = 8;
 /// The slowest inner loop allowed, Hz (issue 19: "at least 100 Hz").
 pub const MIN_INNER_RATE_HZ: u32 = 100;
 
+/// The longest tick count a threshold of the step's counters may ask for
+/// ([`BrakeConfig::engage_ticks`], [`FaultLimits::stall_ticks`]: 2³¹ − 1, 24 days at 1 kHz):
+/// a counter below it plus a step's tick gap (below 2³¹) cannot wrap, so the step adds
+/// without saturating.
+pub const MAX_COUNTED_TICKS: u32 = i32::MAX as u32;
+
 /// Largest encoder counts per drum revolution: below 2²⁴ every count within a revolution is an
 /// exact `f32`, so the metres-per-count scale is not the limit of the length's precision.
 pub const MAX_COUNTS_PER_DRUM_REV: u32 = 1 << 24;
@@ -75,7 +81,8 @@ pub struct SpeedGains {
 pub struct BrakeConfig {
     /// Ticks from the release command to the brake being free (its mechanical delay).
     pub release_ticks: u32,
-    /// Ticks at rest (commanded and measured) before the brake engages.
+    /// Ticks at rest (commanded and measured) before the brake engages (at most
+    /// [`MAX_COUNTED_TICKS`]).
     pub engage_ticks: u32,
     /// |speed| at or below which the drum counts as at rest, m/s.
     pub rest_speed_mps: f32,
@@ -93,7 +100,7 @@ pub struct FaultLimits {
     pub stall_duty: f32,
     /// |speed| at or below which a driven drum does not turn, m/s.
     pub stall_speed_mps: f32,
-    /// Ticks of stall that trip the drive.
+    /// Ticks of stall that trip the drive (at most [`MAX_COUNTED_TICKS`]).
     pub stall_ticks: u32,
     /// Consecutive ticks of duty saturation that raise [`DriveFault::DutySaturated`](super::DriveFault::DutySaturated).
     pub saturation_ticks: u32,
@@ -262,7 +269,7 @@ impl DriveConfig {
         positive("max_accel_mps2", self.max_accel_mps2)?;
         let b = &self.brake;
         positive("brake.rest_speed_mps", b.rest_speed_mps)?;
-        nonzero("brake.engage_ticks", b.engage_ticks)?;
+        counted_ticks("brake.engage_ticks", b.engage_ticks)?;
         let f = &self.faults;
         positive("faults.max_encoder_rate_mps", f.max_encoder_rate_mps)?;
         if f.max_encoder_rate_mps < self.max_speed_mps {
@@ -293,7 +300,7 @@ impl DriveConfig {
             ));
         }
         positive("faults.stall_speed_mps", f.stall_speed_mps)?;
-        nonzero("faults.stall_ticks", f.stall_ticks)?;
+        counted_ticks("faults.stall_ticks", f.stall_ticks)?;
         nonzero("faults.saturation_ticks", f.saturation_ticks)?;
         finite("faults.min_tension_n", f.min_tension_n)?;
         finite("faults.max_tension_n", f.max_tension_n)?;
@@ -331,6 +338,15 @@ fn at_least_zero(param: &'static str, v: f32) -> Result<(), DriveConfigError> {
         Ok(())
     } else {
         Err(DriveConfigError::new(param, v, DriveRule::Negative))
+    }
+}
+
+fn counted_ticks(param: &'static str, v: u32) -> Result<(), DriveConfigError> {
+    nonzero(param, v)?;
+    if v <= MAX_COUNTED_TICKS {
+        Ok(())
+    } else {
+        Err(DriveConfigError::new(param, v, DriveRule::OutOfRange))
     }
 }
 

@@ -155,7 +155,8 @@ pub enum DriveFault {
     EncoderJump,
     /// No encoder reading this tick (or none for longer than the loop can bridge).
     EncoderMissing,
-    /// Large duty, no motion, for `stall_ticks`.
+    /// Large duty, no motion, for `stall_ticks`, the drive not at rest (at rest, the brake
+    /// about to engage, a large duty is the motor holding the tension).
     MotorStall,
     /// The duty has been saturated for `saturation_ticks`: the drum cannot follow.
     DutySaturated,
@@ -382,6 +383,10 @@ struct Derived {
     coulomb_per_band: f32,
     /// 1 / τ_max: duty per N m.
     per_max_torque: f32,
+    /// The stall duty as a torque, stall duty × τ_max, N m: the stall check compares the
+    /// torque with it, without working out the duty twice (2 instructions less on the stall
+    /// path, `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
+    stall_torque_nm: f32,
 }
 
 /// The inner speed loop with its brake and fault logic.
@@ -425,6 +430,7 @@ impl SpeedLoop {
             viscous_per_radius: cfg.drum.viscous_nm_per_radps / r,
             coulomb_per_band: cfg.drum.coulomb_nm / cfg.drum.coulomb_band_mps,
             per_max_torque: 1.0 / cfg.max_torque_nm,
+            stall_torque_nm: cfg.faults.stall_duty * cfg.max_torque_nm,
         };
         Ok(Self {
             cfg,
@@ -579,7 +585,7 @@ impl SpeedLoop {
         } else {
             None
         };
-        let counted = self.odometer.update(tick, reading);
+        let counted = self.odometer.update_after(tick, gap_ticks, reading);
         if let Err(f) = counted {
             let fault = match f {
                 CountFault::Jump => DriveFault::EncoderJump,
@@ -603,9 +609,16 @@ impl SpeedLoop {
         // The torque: PI + feed-forward with the brake free; while it lifts, the motor takes
         // over the tension's torque, nothing else; otherwise the motor is off.
         let (ref_mps, ref_accel_mps2, torque_nm) = match self.brake {
-            Brake::Released { .. } => {
+            Brake::Released { rest_ticks } => {
                 let law = self.speed_law(tick, gap_ticks, speed_mps, tension_n);
-                if self.count_stall(gap_ticks, speed_mps, law.2) {
+                if rest_ticks > 0 {
+                    // At rest, the brake about to engage: a large duty holding a still drum
+                    // is the motor holding the tension, not a stall (and the step counts one
+                    // or the other: 12 instructions less on its worst path,
+                    // `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
+                    self.stall_ticks = 0;
+                    law
+                } else if self.count_stall(gap_ticks, speed_mps, law.2) {
                     faults.insert(DriveFault::MotorStall);
                     (law.0, law.1, 0.0)
                 } else {
@@ -703,18 +716,22 @@ impl SpeedLoop {
         (ref_mps, ref_accel_mps2, torque_nm)
     }
 
-    /// The stall counter, brake free: the ticks the drive has been stalled (|duty| at or above
-    /// the stall duty, the drum slower than the stall speed), reset otherwise; at the stall
-    /// ticks it trips the drive (returns true: the step's torque is then 0). Run from the
-    /// `Released` arm of the step, it needs no test of the brake's state (the other arms reset
-    /// the counter), and the threshold is compared only while counting.
+    /// The stall counter, brake free and not at rest: the ticks the drive has been stalled
+    /// (|duty| at or above the stall duty, the drum slower than the stall speed), reset
+    /// otherwise; at the stall ticks it trips the drive (returns true: the step's torque is
+    /// then 0). Run from the `Released` arm of the step, it needs no test of the brake's state
+    /// (the other arms reset the counter), and the threshold is compared only while counting.
     fn count_stall(&mut self, gap_ticks: u32, speed_mps: f32, torque_nm: f32) -> bool {
         let f = &self.cfg.faults;
-        let duty = torque_nm * self.derived.per_max_torque;
-        if duty.abs() >= f.stall_duty && speed_mps.abs() <= f.stall_speed_mps {
-            self.stall_ticks = self.stall_ticks.saturating_add(gap_ticks);
+        if torque_nm.abs() >= self.derived.stall_torque_nm && speed_mps.abs() <= f.stall_speed_mps {
+            // (Cannot wrap: below `stall_ticks` ≤ 2³¹ − 1, plus a gap below 2³¹; see
+            // `Odometer::update_after` for the figure.)
+            self.stall_ticks = self.stall_ticks.wrapping_add(gap_ticks);
             if self.stall_ticks >= f.stall_ticks {
-                self.trip(DriveFault::MotorStall);
+                // `trip` without its test of the brake (free here) and without its writes
+                // of the output, which the step writes next.
+                self.brake = Brake::Tripped(DriveFault::MotorStall);
+                self.integral_nm = 0.0;
                 return true;
             }
         } else {
@@ -792,7 +809,8 @@ impl SpeedLoop {
                 if !at_rest {
                     Brake::Released { rest_ticks: 0 }
                 } else {
-                    let rest_ticks = rest_ticks.saturating_add(gap_ticks);
+                    // (Cannot wrap: below `engage_ticks` ≤ 2³¹ − 1, plus a gap below 2³¹.)
+                    let rest_ticks = rest_ticks.wrapping_add(gap_ticks);
                     if rest_ticks >= self.cfg.brake.engage_ticks {
                         Brake::Engaged
                     } else {
@@ -851,16 +869,19 @@ impl SpeedLoop {
 /// `x` limited to [−limit, limit] (limit ≥ 0), and whether it was beyond: by comparisons,
 /// which decide both at once (`f32::clamp` panics on bad bounds, and `f32::min`/`max` are
 /// library calls, `fminf`/`fmaxf`, on the Cortex-M4F: with them the step took 420 instructions,
-/// median, `examples/bench_speed_loop.rs`). A NaN `x` gives 0 (no torque), not saturated.
+/// median, `examples/bench_speed_loop.rs`). A NaN `x` gives 0 (no torque), not saturated: it
+/// fails both comparisons of the in-range test, so a value inside the limits takes two
+/// comparisons and no NaN test (6 instructions less on the step's unsaturated path than
+/// testing for NaN after the two bounds, `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
 fn saturate(x: f32, limit: f32) -> (f32, bool) {
     if x > limit {
         (limit, true)
+    } else if x >= -limit {
+        (x, false)
     } else if x < -limit {
         (-limit, true)
-    } else if x.is_nan() {
-        (0.0, false)
     } else {
-        (x, false)
+        (0.0, false)
     }
 }
 

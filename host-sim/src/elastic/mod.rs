@@ -671,7 +671,7 @@ impl ElasticPlant {
         let locked = p.reel.locked;
         let rate = if locked { 0.0 } else { init.rate_mps };
         let (mut speed, mut integral) = (0.0, 0.0);
-        let reel = match p.reel.model {
+        let mut reel = match p.reel.model {
             _ if locked => ReelState::Locked,
             ReelModel::Ideal => ReelState::Ideal,
             ReelModel::Lag(mut r) => {
@@ -690,7 +690,7 @@ impl ElasticPlant {
                 };
                 ReelState::Motor { drum, motion }
             }
-            // The flight drive starts at rest with its brake engaged (it releases it itself).
+            // The flight drive starts braked at rest here; spun up below.
             ReelModel::Flight(f) => ReelState::Flight {
                 drum: f.drum,
                 motion: Motion::Stuck,
@@ -700,14 +700,30 @@ impl ElasticPlant {
         };
         let flight = match p.reel.model {
             ReelModel::Flight(f) if !locked => {
-                let drum = FlightDrum::new(f.drum, f.drive_config()).map_err(|_| {
+                let mut drum = FlightDrum::new(f.drum, f.drive_config()).map_err(|_| {
                     ElasticError::Invalid {
                         field: "reel (flight drive configuration)",
                         value: f64::from(f.inner_rate_hz),
                         rule: "a valid tss_reel::reel_drive::DriveConfig",
                     }
                 })?;
-                Some((Box::new(drum), init.length_m))
+                // The reel pays out at l̇(0) when the mission starts, as the motor reel does
+                // (`FlightDrum::spin_up`: the drive's own brake release and ramp, before t = 0).
+                // The encoder's origin is where the spin-up started, so that its count goes
+                // on from the spin-up's.
+                let travel_m = drum.spin_up(rate);
+                let (drum_radps, motion) = drum.drum_state();
+                speed = drum_radps;
+                if let ReelState::Flight {
+                    motion: m,
+                    brake: b,
+                    ..
+                } = &mut reel
+                {
+                    *m = motion;
+                    *b = !drum.speed_loop().brake().brake_released();
+                }
+                Some((Box::new(drum), init.length_m - travel_m))
             }
             _ => None,
         };
@@ -720,9 +736,10 @@ impl ElasticPlant {
             pos,
             vel,
         };
-        let reel_rate_mps = match reel {
-            ReelState::Lag(r) => r.rate_mps,
-            ReelState::Flight { .. } => 0.0,
+        let reel_rate_mps = match (&reel, &flight) {
+            (ReelState::Lag(r), _) => r.rate_mps,
+            (ReelState::Flight { drum, .. }, Some(_)) => drum.radius_m * speed,
+            (ReelState::Flight { .. }, None) => 0.0,
             _ => rate,
         };
         Ok(Self {

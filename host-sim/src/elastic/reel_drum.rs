@@ -247,6 +247,11 @@ impl FlightDrum {
         cfg.gains.ki_nm_per_m = (kp * crossover_radps / 4.0) as f32;
         // The drum's own limits, not the reference reel's.
         cfg.max_speed_mps = cfg.max_speed_mps.min(cfg.faults.max_encoder_rate_mps);
+        // At rest below 1 mm/s (half a count of the speed window), not the reference reel's
+        // 5 mm/s: the paper's law deploys as slowly as 2.7 mm/s (stage 1, near 930 s), and a
+        // brake engaging there stops the drum under a tether of 1 mN, which catches the
+        // sub-satellite and sends it back (slack from 780 s on in paper-drive).
+        cfg.brake.rest_speed_mps = 1e-3;
         cfg
     }
 
@@ -356,6 +361,35 @@ impl FlightDrum {
         let end_error = (speed_mps - command_mps).abs();
         let f = &mut self.figures;
         f.max_period_end_error_mps = f.max_period_end_error_mps.max(end_error);
+    }
+
+    /// Spins the drum up to `rate_mps` (surface) before the mission starts, the tether not yet
+    /// pulling: the speed loop releases its brake, ramps to the rate within a law period and
+    /// holds it for another, the drum integrated here ([`FlightDrum::period`]). The mission's
+    /// initial condition is a reel already paying out at l̇(0) (as the motor reel starts,
+    /// `ElasticPlant::new`): started braked instead, the drum held the tether while the
+    /// sub-satellite left at l̇(0), and the jerk (7.4 N at the reel within the first second)
+    /// sent it back, the tether slack from then on. The figures restart at the end (the
+    /// spin-up is not the mission's). Returns the drum's travel, m (pay-out positive).
+    pub fn spin_up(&mut self, rate_mps: f64) -> f64 {
+        let command = tss_reel::reel_drive::RateCommand {
+            rate_mps: rate_mps as f32,
+            accel_mps2: 0.0,
+            safe_hold: false,
+        };
+        let ticks = self.speed.config().outer_period_ticks;
+        self.period(command, 0.0, ticks);
+        self.period(command, 0.0, ticks);
+        self.figures = DriveFigures {
+            tension_range_n: (f64::INFINITY, f64::NEG_INFINITY),
+            ..DriveFigures::default()
+        };
+        self.angle_counts / self.counts_per_rad * self.params.radius_m
+    }
+
+    /// The drum's rate, rad/s (pay-out positive), and its stick–slip state.
+    pub fn drum_state(&self) -> (f64, Motion) {
+        (self.rate_radps, self.motion)
     }
 
     /// The last tick's duty, −1…1.
