@@ -23,8 +23,9 @@
 //! To beat the 40-instruction resolution, each measurement runs the same call on `K` copies of
 //! the same state (the controller is `Clone`; the pure functions get `K` copies of their
 //! input), each behind `core::hint::black_box` so nothing is hoisted or shared between copies,
-//! and divides by `K`. Each result is kept alive by reference where the call wrote it (a copy
-//! of the 52-byte `Output` would add eight instructions that are the harness's, not the step's). The cost of the timing loop itself (measured with an empty body) is
+//! and divides by `K`. Each result is kept alive where the call left it (`Controller::step`
+//! returns a reference to the output it keeps; a copy of the 60-byte `Output` would add
+//! instructions that are the harness's, not the step's). The cost of the timing loop itself (measured with an empty body) is
 //! subtracted. The figures are instructions, not cycles: on silicon a VDIV/VSQRT takes 14
 //! cycles and a taken branch 2–4, so cycles exceed instructions.
 //!
@@ -290,8 +291,8 @@ mod bench {
                 }),
             };
             let out = match &input {
-                Some(x) => ctl.step(x),
-                None => ctl.step_missing(tick),
+                Some(x) => *ctl.step(x),
+                None => *ctl.step_missing(tick),
             };
             r.step.add(cost, tick);
             let p = &mut r.phases[phase_index(out.phase)];

@@ -210,7 +210,7 @@ where
             None,
         ),
     };
-    let reel_error = dev.reel.command(&output).err().map(|e| e.kind());
+    let reel_error = dev.reel.command(output).err().map(|e| e.kind());
     Cycle {
         sensor_error,
         reading_error,

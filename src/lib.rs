@@ -22,8 +22,10 @@
 //!     // The paper's mission (Section 6): every parameter is validated here, once.
 //!     let mut ctl = Controller::new(Config::<f32>::paper())?;
 //!
-//!     // One call per control period (1 s), with the sensed sample of this tick.
-//!     let out = ctl.step(&Input {
+//!     // One call per control period (1 s), with the sensed sample of this tick. The step
+//!     // returns its output by reference (the one kept in the controller); copy it out to keep it
+//!     // while the controller is used again.
+//!     let out = *ctl.step(&Input {
 //!         tick: 0,                          // whole control periods since the start
 //!         length_m: 1.0,                    // l, m
 //!         reel_rate_mps: None,              // l̇ from the reel's encoder, m/s (not used here)
@@ -40,7 +42,7 @@
 //!             let _ = (event.tick, phase); // e.g. tell the ground
 //!         }
 //!     }
-//!     // `out` is the step's output, a copy: send it to the reel.
+//!     // `out` is the step's output: send it to the reel.
 //!     assert_eq!(out.phase, Phase::Deploy);
 //!     assert!((out.rate_cmd_mps - 0.1).abs() < 1e-6); // the Eq. 29 blend starts from l̇0 = 0.1 m/s
 //!     assert!(out.fault.is_none());

@@ -147,7 +147,7 @@ fn input_rounding(c64: &Controller<f64>, x: &Input<f64>, y64: f64) -> f64 {
     [h, -h]
         .iter()
         .map(|d| {
-            let out = c64.clone().step(&Input {
+            let out = *c64.clone().step(&Input {
                 alpha_rad: Some(alpha + d),
                 ..*x
             });

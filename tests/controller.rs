@@ -108,7 +108,7 @@ fn dropout_coasts_then_holds_then_recovers_through_the_blend() {
 
     // Dropout: coast on the last command for coast_ticks, length predicted.
     let t0 = 600;
-    let first = ctl.step_missing(t0);
+    let first = *ctl.step_missing(t0);
     assert_eq!(first.health, Health::Degraded);
     assert_eq!(first.fault, Some(Fault::Sensor(Sensor::Missing)));
     assert!(first
@@ -119,7 +119,7 @@ fn dropout_coasts_then_holds_then_recovers_through_the_blend() {
     let coast = cfg.monitor.coast_ticks;
     let mut last = first;
     for k in 1..coast {
-        last = ctl.step_missing(t0 + k);
+        last = *ctl.step_missing(t0 + k);
         assert_eq!(last.health, Health::Degraded);
         assert_eq!(last.rate_cmd_mps, cruise);
     }
@@ -132,7 +132,7 @@ fn dropout_coasts_then_holds_then_recovers_through_the_blend() {
         .min(cfg.envelope.max_accel_mps2)
         * cfg.period_s;
     let mut t = t0 + coast;
-    let hold = ctl.step_missing(t);
+    let hold = *ctl.step_missing(t);
     assert_eq!(hold.health, Health::SafeHold);
     assert!(hold.flags.contains(Flags::HEALTH_CHANGED));
     assert!((hold.rate_cmd_mps - prev).abs() <= dv * (1.0 + 1e-6));
@@ -140,7 +140,7 @@ fn dropout_coasts_then_holds_then_recovers_through_the_blend() {
     let ramp_ticks = (cruise / dv).ceil() as u32;
     for _ in 0..ramp_ticks + 10 {
         t += 1;
-        let o = ctl.step_missing(t);
+        let o = *ctl.step_missing(t);
         assert!(o.rate_cmd_mps.abs() <= prev.abs());
         assert!(
             (o.rate_cmd_mps - prev).abs() <= dv * (1.0 + 1e-6),
@@ -194,7 +194,7 @@ fn a_missing_first_sample_does_not_poison_the_length_check() {
     // (at any length) anchors it instead of failing as a jump.
     let mut ctl = paper();
     assert_eq!(ctl.step_missing(0).health, Health::Degraded);
-    let o = ctl.step(&sample(1, 12_345.0));
+    let o = *ctl.step(&sample(1, 12_345.0));
     assert_eq!(o.health, Health::Nominal, "{o:?}");
     assert_eq!(o.length_estimate_m, 12_345.0);
 }
@@ -202,11 +202,11 @@ fn a_missing_first_sample_does_not_poison_the_length_check() {
 #[test]
 fn length_glitch_is_rejected_and_the_prediction_used() {
     let mut ctl = paper();
-    let o = ctl.step(&sample(0, 5_000.0));
-    let glitch = ctl.step(&sample(1, 5_100.0));
+    let o = *ctl.step(&sample(0, 5_000.0));
+    let glitch = *ctl.step(&sample(1, 5_100.0));
     assert_eq!(glitch.fault, Some(Fault::Sensor(Sensor::LengthJump)));
     assert!((glitch.length_estimate_m - (5_000.0 + o.rate_cmd_mps)).abs() < 1e-2);
-    let ok = ctl.step(&sample(2, 5_000.0 + 2.0 * o.rate_cmd_mps));
+    let ok = *ctl.step(&sample(2, 5_000.0 + 2.0 * o.rate_cmd_mps));
     assert_eq!(ok.health, Health::Nominal);
 }
 
@@ -279,7 +279,7 @@ fn non_finite_and_out_of_range_samples_are_typed() {
     for (input, sensor) in cases {
         let mut ctl = paper();
         ctl.step(&sample(0, 1.0));
-        let o: Output<f32> = ctl.step(&input);
+        let o: Output<f32> = *ctl.step(&input);
         assert_eq!(o.fault, Some(Fault::Sensor(sensor)), "{input:?}");
         assert!(o.rate_cmd_mps.is_finite());
     }
@@ -347,7 +347,7 @@ fn stage2_starts_on_command_and_restarts_the_blend_from_the_current_rate() {
 #[test]
 fn early_deployment_is_flagged_outside_the_equilibrium_region() {
     // l̇/l = 0.1 s⁻¹ at l = 1 m: x = 2·0.1/(n·1) ≈ 189 ≫ 1.5 (Eq. 13).
-    let o = paper().step(&sample(0, 1.0));
+    let o = *paper().step(&sample(0, 1.0));
     assert!(o.flags.contains(Flags::NO_EQUILIBRIUM));
     assert!(o.equilibrium_margin < -100.0);
     // Station keeping at 30 km is inside with margin ≈ 1.5.
@@ -435,11 +435,11 @@ fn slow_reel() -> Controller<f32> {
 /// Flies `ticks` nominal periods from tick `from` on the deployment plateau, the length
 /// following the command; returns the length and the last output.
 fn fly(ctl: &mut Controller<f32>, from: u32, ticks: u32, mut l: f32) -> (f32, Output<f32>) {
-    let mut out = ctl.step(&sample(from, l));
+    let mut out = *ctl.step(&sample(from, l));
     for k in 1..ticks {
         let t = from.wrapping_add(k);
         l += out.rate_cmd_mps;
-        out = ctl.step(&sample(t, l));
+        out = *ctl.step(&sample(t, l));
         assert_eq!(out.health, Health::Nominal, "{out:?}");
     }
     (l, out)
@@ -592,7 +592,7 @@ fn an_intermittent_sensor_reaches_safe_hold() {
             tick += 1;
             l += out.rate_cmd_mps;
             let alpha_rad = if k < 20 { f32::NAN } else { -0.7 };
-            out = ctl.step(&Input {
+            out = *ctl.step(&Input {
                 alpha_rad: Some(alpha_rad),
                 ..sample(tick, l)
             });
@@ -609,7 +609,7 @@ fn an_intermittent_sensor_reaches_safe_hold() {
     for tick in 100..1_100 {
         l += out.rate_cmd_mps;
         let alpha_rad = if tick % 10 == 0 { f32::NAN } else { -0.7 };
-        out = ctl.step(&Input {
+        out = *ctl.step(&Input {
             alpha_rad: Some(alpha_rad),
             ..sample(tick, l)
         });
@@ -637,13 +637,13 @@ fn a_deployment_that_stops_progressing_is_reported() {
     let mut ctl = paper();
     let mut l = 2_000.0_f32;
     let mut first = None;
-    let mut out = ctl.step(&Input {
+    let mut out = *ctl.step(&Input {
         alpha_rad: Some(alpha_rad),
         ..sample(0, l)
     });
     for tick in 1..20_000 {
         l += out.rate_cmd_mps;
-        out = ctl.step(&Input {
+        out = *ctl.step(&Input {
             alpha_rad: Some(alpha_rad),
             ..sample(tick, l)
         });
@@ -754,7 +754,7 @@ fn a_gap_in_the_calls_longer_than_the_estimator_carries_drops_the_estimate() {
     assert!(ctl.estimate().is_some());
     // More periods than the estimator carries: dropped, and this sample starts it afresh.
     let tick = 4 + MAX_CARRIED_PERIODS + 1;
-    let o = ctl.step(&x(tick));
+    let o = *ctl.step(&x(tick));
     assert_eq!(lost(&mut ctl), Some(tick));
     let e = ctl.estimate().expect("restarted from this sample");
     assert_eq!((e.alpha_rad, e.alpha_rate_radps), (-0.7, 0.0));

@@ -42,7 +42,7 @@ fn bench(c: &mut Criterion) {
     g.bench_function("deploy_band", |b| {
         b.iter_batched_ref(
             || ctl.clone(),
-            |c| c.step(black_box(&x)),
+            |c| *c.step(black_box(&x)),
             BatchSize::SmallInput,
         )
     });

@@ -160,8 +160,8 @@ pub trait Stepper<T> {
 impl<T: Real> Stepper<T> for Controller<T> {
     fn step(&mut self, tick: u32, input: Option<&Input<T>>) -> Result<Output<T>, SimError> {
         Ok(match input {
-            Some(x) => Controller::step(self, x),
-            None => self.step_missing(tick),
+            Some(x) => *Controller::step(self, x),
+            None => *self.step_missing(tick),
         })
     }
 }

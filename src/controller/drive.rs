@@ -30,7 +30,7 @@ impl<T: Real> Controller<T> {
         tick: u32,
         sample: Option<&Input<T>>,
         drive: DriveFaults,
-    ) -> Output<T> {
+    ) -> &Output<T> {
         let health = self.health.health();
         let sample = match drive.outer_reaction() {
             OuterReaction::Report => sample,
@@ -46,6 +46,6 @@ impl<T: Real> Controller<T> {
             .flags
             .set_if(self.out.health != health, Flags::HEALTH_CHANGED);
         self.record_events();
-        self.out
+        &self.out
     }
 }

@@ -276,10 +276,10 @@ pub fn run(_clock: ControlClock) -> ! {
             }
         };
         let output = match reading {
-            Ok(s) => controller.step(&input(tick, &s)),
+            Ok(s) => *controller.step(&input(tick, &s)),
             Err(_) => {
                 dropouts = dropouts.saturating_add(1);
-                controller.step_missing(tick)
+                *controller.step_missing(tick)
             }
         };
         let mut reel = CommandLink {

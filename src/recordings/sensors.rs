@@ -152,10 +152,10 @@ mod tests {
             let expected = if (DROPOUT_FROM_TICK..DROPOUT_UNTIL_TICK).contains(&tick) {
                 dropouts += 1;
                 assert_eq!(cycle.sensor_error, Some(ErrorKind::NoSample));
-                direct.step_missing(tick)
+                *direct.step_missing(tick)
             } else {
                 assert_eq!(cycle.sensor_error, None, "tick {tick}");
-                direct.step(&Input {
+                *direct.step(&Input {
                     tick,
                     length_m: s[0],
                     reel_rate_mps: Replay.read_rate_mps(tick).ok(),

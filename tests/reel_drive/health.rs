@@ -46,7 +46,7 @@ fn nominal_for(ticks: u32) -> Controller<f32> {
 /// One period at tick 100 with `fault` after 100 quiet ones.
 fn one_period_with(fault: DriveFault) -> (Controller<f32>, Output<f32>) {
     let mut ctl = nominal_for(100);
-    let out = ctl.step_with_drive(100, Some(&input(100)), faults(&[fault]));
+    let out = *ctl.step_with_drive(100, Some(&input(100)), faults(&[fault]));
     (ctl, out)
 }
 
@@ -74,7 +74,7 @@ fn reported_faults_leave_the_step_as_it_is() {
         assert_eq!(fault.outer_reaction(), OuterReaction::Report);
         let (_, out) = one_period_with(fault);
         let mut plain = nominal_for(100);
-        assert_eq!(out, plain.step(&input(100)), "{fault:?}");
+        assert_eq!(out, *plain.step(&input(100)), "{fault:?}");
         assert_eq!(out.health, Health::Nominal);
     }
 }

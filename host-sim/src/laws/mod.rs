@@ -161,7 +161,7 @@ impl LawStepper {
         };
         let cfg = controller_config::<f32>(sc)?;
         let stage2_tick = (sc.stage2.start_time_s / sc.controller.period_s).round() as u32;
-        let template = Controller::new(cfg)
+        let template = *Controller::new(cfg)
             .map_err(SimError::Config)?
             .step_missing(0);
         Ok(Some(Self {
