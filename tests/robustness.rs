@@ -189,7 +189,7 @@ fn fly_on(cfg: Config<f32>, start: u32, events: &[Event]) {
             }
             Event::Backwards { by } => ctl.step_missing(tick.wrapping_sub(by)),
         };
-        assert_output_sane(&out, prev_rate, &env);
+        assert_output_sane(out, prev_rate, &env);
         prev_rate = out.rate_cmd_mps;
     }
 }
