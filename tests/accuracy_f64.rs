@@ -187,7 +187,7 @@ fn compare(ticks: u32, orbit_rate_radps: f32, sample: impl Fn(u32) -> Option<[f3
                 let x64 = to_f64(x);
                 let before = c64.clone();
                 let o64 = c64.step(&x64);
-                let sens = if law_ran(&o64) {
+                let sens = if law_ran(o64) {
                     input_rounding(&before, &x64, o64.rate_cmd_mps)
                 } else {
                     0.0
@@ -202,8 +202,8 @@ fn compare(ticks: u32, orbit_rate_radps: f32, sample: impl Fn(u32) -> Option<[f3
         f.max_input_rounding = f.max_input_rounding.max(sens);
         let y64 = o64.rate_cmd_mps;
         let e = rel_diff(o32.rate_cmd_mps, y64);
-        let dref = ref_diff(&o32, &o64);
-        if law_ran(&o32) && law_ran(&o64) {
+        let dref = ref_diff(o32, o64);
+        if law_ran(o32) && law_ran(o64) {
             f.rels.push(e);
             f.max_ref_angle_diff_rad = f.max_ref_angle_diff_rad.max(dref);
             if e > GOAL && e > UNEXPLAINED_FACTOR * sens {
@@ -342,7 +342,7 @@ fn random_states_f32_vs_f64() {
         if o32.phase != o64.phase || o32.health != o64.health {
             f.state_mismatches += 1;
         }
-        if !(law_ran(&o32) && law_ran(&o64)) {
+        if !(law_ran(o32) && law_ran(o64)) {
             continue;
         }
         let y64 = o64.rate_cmd_mps;
@@ -353,7 +353,7 @@ fn random_states_f32_vs_f64() {
         if e > GOAL && e > UNEXPLAINED_FACTOR * sens {
             f.unexplained += 1;
         }
-        let dref = ref_diff(&o32, &o64);
+        let dref = ref_diff(o32, o64);
         f.max_ref_angle_diff_rad = f.max_ref_angle_diff_rad.max(dref);
         if e > f.worst.rel {
             f.worst = Worst {
