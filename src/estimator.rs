@@ -99,7 +99,10 @@
 //! The covariance is stored as its upper triangle, so it is symmetric by construction. The
 //! update is the Joseph form P⁺ = (I − KH) P⁻ (I − KH)ᵀ + K R Kᵀ, a sum of two positive
 //! semidefinite terms whatever rounding does to K (the short form (I − KH)P⁻ is not), written
-//! out for H = (1 0 0). Negative rounding residue on the diagonal is cut to zero (adding a
+//! out for H = (1 0 0); its α row is evaluated as what it equals, R K (to second order in K's
+//! error, like the rest of the form), which keeps the digits the row written out loses by
+//! cancellation when P_αα⁻ ≫ R (see `Sym3::joseph`). Negative rounding residue on the
+//! diagonal is cut to zero (adding a
 //! non-negative diagonal keeps P positive semidefinite). After each prediction a variance
 //! above its cap ([`ALPHA_VARIANCE_CAP_RAD2`], the initial α̇ and d variances) is brought back
 //! to the cap, its covariances scaled down with it (a congruence plus a non-negative diagonal,
@@ -112,12 +115,13 @@
 //!
 //! Plain scalars on the structure, not nalgebra matrices: Φ's d row is e₃ᵀ and P is symmetric,
 //! so Φ P Φᵀ is 30 multiply-adds on the 6 stored entries; Ψ and Φ share two polynomials of the
-//! series (12 operations), and the Joseph update for H = (1 0 0), regrouped, is 15 multiply-adds;
+//! series (12 operations), and the Joseph update for H = (1 0 0), regrouped, is 3 products and 8
+//! multiply-adds;
 //! one sin_cos (of 2α̂, lent by the law in the controller) and two divisions a step. On the
 //! Cortex-M4F (`examples/bench_estimator.rs`, flight profile, over the paper mission) a step
-//! takes 355 instructions with a sample (median; 370 at worst, in the first ticks, where the α̇
-//! variance sits at its cap), 275 in a dropout and 300 with a gated sample (408/445, 318 and 348
-//! before issue 18's budget round); nalgebra's general 3×3 forms of the two covariance products
+//! takes 340 instructions with a sample (median; 355 at worst, in the first ticks, where the α̇
+//! variance sits at its cap), 268 in a dropout and 295 with a gated sample (355/370, 275 and 300
+//! before session 10's round; 408/445, 318 and 348 before issue 18's budget round); nalgebra's general 3×3 forms of the two covariance products
 //! alone take 815 (Φ P Φᵀ + Q) and 1 170 (Joseph)
 //! at opt-level "s".
 
@@ -634,6 +638,14 @@ impl<T: Real> Estimator<T> {
         }
     }
 
+    /// [`Estimator::lend_sin_cos_two_alpha`] for a caller that computed them for the estimate's
+    /// α̂ itself (the controller's law, which flies on it): no comparison of the angles.
+    pub(crate) fn lend_sin_cos_two_alpha_hat(&mut self, sin_two_alpha: T, cos_two_alpha: T) {
+        if let Some(t) = &mut self.track {
+            t.trig = Some((sin_two_alpha, cos_two_alpha));
+        }
+    }
+
     /// Drops the estimate: the next sample starts afresh (a caller that cannot say what
     /// drove the libration over a period).
     pub fn reset(&mut self) {
@@ -738,7 +750,14 @@ impl<T: Real> Estimator<T> {
         // x⁺ = x + h Ψ f(x): α⁺ = α + h(Ψ_αα α̇ + h w α̈), α̇⁺ = (1 − k w) α̇ + h ψ α̈.
         let alpha = t.alpha + h * (psi_aa * t.rate + h * w * accel);
         let rate = phi_aa * t.rate + h_psi * accel;
-        if !(rate.abs() <= f(MAX_ALPHA_RATE_RADPS) && alpha.is_finite()) {
+        // α̇⁺ bounds α⁺: h ψ α̈ = α̇⁺ − (1 − k w) α̇, so
+        //   α⁺ − α = h Ψ_αα α̇ + (h w/ψ)(α̇⁺ − (1 − k w) α̇),
+        // a few h at most for |α̇|, |α̇⁺| ≤ 1 (|u| ≤ 1/2 and |k| < 0.1 keep ψ near 1, w near 1/2);
+        // α̂ starts and is updated within [−π, π] plus a gated innovation. A NaN or an infinity
+        // in the state or the drive reaches α̇⁺, so its test alone finds a diverged estimate.
+        // (α̂'s own `is_finite` took 8 instructions: scripts/bench-target, mission median/worst
+        // 888/910 → 880/903.)
+        if above_or_nan(rate.abs(), f(MAX_ALPHA_RATE_RADPS)) {
             return Err(Prediction::Diverged);
         }
         let phi = [
@@ -958,9 +977,18 @@ impl<T: Real> Sym3<T> {
         p
     }
 
-    /// The Joseph-form update (I − K e₁ᵀ) P (I − K e₁ᵀ)ᵀ + r K Kᵀ, by its upper triangle.
-    /// With p = P e₁ (P's α column) and S = P_αα + r, it expands to P − K pᵀ − p Kᵀ + S K Kᵀ,
-    /// evaluated as
+    /// The Joseph-form update (I − K e₁ᵀ) P (I − K e₁ᵀ)ᵀ + r K Kᵀ for the gain K = p/S worked
+    /// out from this P (p = P e₁, P's α column; S = P_αα + r), by its upper triangle.
+    ///
+    /// α's row is r K. For H = e₁ the Joseph form's α row is (1 − K_α)(p − P_αα K) + r K_α K,
+    /// which equals r p/S up to second order in an error δ of K (S δδᵀ terms, as everywhere in
+    /// the Joseph form), and r K is r p/S to the rounding of K (two roundings of each entry).
+    /// The row written out, p − P_αα K − K_α c, cancels to r/S of p, so where P_αα ≫ r (the
+    /// first sample after a dropout) it lost about S/r roundings of p that r K keeps; and
+    /// P⁺_αα = r K_α is non-negative wherever P_αα is (and cut to zero otherwise, as the block's
+    /// diagonal).
+    ///
+    /// The (α̇, d) block is the Joseph form's, P − K pᵀ − p Kᵀ + S K Kᵀ, evaluated as
     ///
     /// ```text
     ///   P⁺_ij = P_ij − K_i c_j − p_i K_j,    c = p − S K,
@@ -968,19 +996,22 @@ impl<T: Real> Sym3<T> {
     ///
     /// the same expression regrouped: c is K's own error (0 for the exact gain p/S), so an
     /// error δ in K still enters P⁺ only at second order (S δδᵀ), which is what the Joseph form
-    /// is for; the short form P − K pᵀ is first order in δ. 15 multiply-adds where the product
-    /// written out took 27. Negative rounding residue on the diagonal is cut to zero.
+    /// is for; the short form P − K pᵀ is first order in δ. Negative rounding residue on its
+    /// diagonal is cut to zero.
+    // 3 products and 8 multiply-adds with 3 floors where the whole Joseph form regrouped took
+    // 15 multiply-adds with 3 floors (and 27 written out): scripts/bench-target, mission
+    // median/worst 895/918 → 888/910.
     fn joseph(&self, k: &[T; 3], r: T) -> Self {
         let p = self;
         let s = p.aa + r;
-        let c = [p.aa - s * k[0], p.aw - s * k[1], p.ad - s * k[2]];
+        let c = [p.aw - s * k[1], p.ad - s * k[2]];
         Self {
-            aa: non_negative(p.aa - k[0] * c[0] - p.aa * k[0]),
-            aw: p.aw - k[0] * c[1] - p.aa * k[1],
-            ad: p.ad - k[0] * c[2] - p.aa * k[2],
-            ww: non_negative(p.ww - k[1] * c[1] - p.aw * k[1]),
-            wd: p.wd - k[1] * c[2] - p.aw * k[2],
-            dd: non_negative(p.dd - k[2] * c[2] - p.ad * k[2]),
+            aa: non_negative(r * k[0]),
+            aw: r * k[1],
+            ad: r * k[2],
+            ww: non_negative(p.ww - k[1] * c[0] - p.aw * k[1]),
+            wd: p.wd - k[1] * c[1] - p.aw * k[2],
+            dd: non_negative(p.dd - k[2] * c[1] - p.ad * k[2]),
         }
     }
 }
@@ -1275,6 +1306,40 @@ mod tests {
         assert!((j.ww - short[2]).abs() < 1e-9 * p.ww);
         // Leading minors positive.
         assert!(j.aa > 0.0 && j.aa * j.ww - j.aw * j.aw > 0.0);
+    }
+
+    #[test]
+    fn joseph_update_keeps_the_alpha_row_accurate_after_a_dropout() {
+        // P_αα at its cap, a million times R: the α row of the posterior, r p/S, is 1e-8 of
+        // p. Evaluated as the Joseph form's p − P_αα K − K_α c it cancelled to nothing in
+        // f32 (P_αα K_α̇ rounds to P_αα̇ itself); as r K it is within a few roundings.
+        let p = Sym3::<f32> {
+            aa: 1.0,
+            aw: 1.5e-3,
+            ad: 8e-7,
+            ww: 4e-6,
+            wd: 1.9e-9,
+            dd: 1e-12,
+        };
+        let r = 1e-8_f32;
+        let inv = 1.0 / (p.aa + r);
+        let k = [p.aa * inv, p.aw * inv, p.ad * inv];
+        let j = p.joseph(&k, r);
+        let s = f64::from(p.aa) + f64::from(r);
+        let exact = |p_i: f32| f64::from(r) * f64::from(p_i) / s;
+        for (got, p_i) in [(j.aa, p.aa), (j.aw, p.aw), (j.ad, p.ad)] {
+            let want = exact(p_i);
+            assert!(
+                (f64::from(got) - want).abs() <= 4.0 * f64::from(f32::EPSILON) * want.abs(),
+                "{got} vs {want}"
+            );
+        }
+        // The (α̇, d) block is the Schur complement's: positive, the correlations kept below 1.
+        assert!(
+            j.ww > 0.0 && j.dd > 0.0 && j.ww * j.dd > j.wd * j.wd,
+            "{j:?}"
+        );
+        assert!(j.aa * j.ww > j.aw * j.aw, "{j:?}");
     }
 
     #[test]

@@ -129,10 +129,18 @@ impl<T: Real> Estimation<T> {
         self.filter.estimate()
     }
 
-    /// The law computed sin 2α and cos 2α for `alpha_rad` (the estimate's α̂): the next
-    /// prediction reuses them.
+    /// The law computed sin 2α and cos 2α for `alpha_rad`, the α̂ of this step's
+    /// [`Estimated::Usable`] verdict: the next prediction reuses them.
+    // The law flies on the verdict's α̂ and nothing moves the estimate between the verdict and
+    // this call, so the filter need not compare the angles (a debug assertion does): the
+    // comparison (and the angle kept across the law for it) took 3 instructions a step
+    // (scripts/bench-target, mission median 898 → 895).
     pub(super) fn lend_sin_cos_two_alpha(&mut self, alpha_rad: T, sin: T, cos: T) {
-        self.filter.lend_sin_cos_two_alpha(alpha_rad, sin, cos);
+        debug_assert_eq!(
+            self.filter.alpha_rate_and_variance().map(|(a, _, _)| a),
+            Some(alpha_rad)
+        );
+        self.filter.lend_sin_cos_two_alpha_hat(sin, cos);
     }
 
     /// The end of a step: it commanded `c` for the coming period (the drive of the next
