@@ -585,7 +585,10 @@ impl<T: Real> Estimator<T> {
             None => Prediction::NoEstimate,
             Some(track) => match self.predict(track, drive, checks) {
                 Ok(next) => {
-                    self.track = Some(next);
+                    // Capped where it is kept: the common case, no cap reached, then stores the
+                    // predicted covariance as it is, where a capped copy was merged with it
+                    // (mission median/worst 875/898 → 873/893, scripts/bench-target).
+                    self.track.insert(next).p.cap(&self.caps);
                     Prediction::Predicted
                 }
                 Err(p) => {
@@ -708,7 +711,8 @@ impl<T: Real> Estimator<T> {
         }
     }
 
-    /// The estimate and covariance carried over one period (module docs, *Discretisation*).
+    /// The estimate and covariance carried over one period (module docs, *Discretisation*),
+    /// before the caps (which the caller applies in place, `Sym3::cap`).
     fn predict(
         &self,
         t: &Track<T>,
@@ -764,11 +768,7 @@ impl<T: Real> Estimator<T> {
             [phi_aa, h_psi, self.period_sq_s2 * w],
             [-(stiffness * h * psi), phi_aa - u * psi, h_psi],
         ];
-        let p =
-            t.p.propagated(&phi)
-                .rounding_loaded()
-                .plus(&self.process)
-                .capped(&self.caps);
+        let p = t.p.propagated(&phi).rounding_loaded().plus(&self.process);
         Ok(Track {
             alpha,
             rate,
@@ -823,13 +823,13 @@ fn above_or_nan<T: Real>(v: T, cap: T) -> bool {
     !(v <= cap)
 }
 
-/// `v` if it is at least 0, else 0 (NaN included): `v.max(0)` in one comparison.
+/// `v` if it is at least 0, else +0: (v + |v|)/2, exact below half the largest float (v + |v|
+/// is 2v or 0, and halving is exact). A NaN stays NaN. For the update's variances, finite and
+/// far below that (P⁻ within its caps, S ≥ R > 0).
+// Three operations without a comparison, where `if v >= 0` took five with its zero (three of
+// them in the Joseph update): scripts/bench-target, mission median/worst 880/903 → 875/898.
 fn non_negative<T: Real>(v: T) -> T {
-    if v >= T::ZERO {
-        v
-    } else {
-        T::ZERO
-    }
+    (v + v.abs()) * T::from_f64(0.5)
 }
 
 /// Which input of a refused drive is at fault (in the order of [`DriveInput`]), `u` = s h.
@@ -945,10 +945,10 @@ impl<T: Real> Sym3<T> {
     // variance sits at its cap, took 45 instructions more than a nominal step with the three
     // ratios worked out together (tools/trace_profile.py --mission-tick 1). The products are
     // those of D P D in the same order, so the result is the same to the bit.
-    fn capped(&self, caps: &[T; 3]) -> Self {
-        let mut p = *self;
+    fn cap(&mut self, caps: &[T; 3]) {
+        let p = self;
         if p.aa <= caps[0] && p.ww <= caps[1] && p.dd <= caps[2] {
-            return p;
+            return;
         }
         if above_or_nan(p.aa, caps[0]) {
             if p.aa > caps[0] {
@@ -974,7 +974,6 @@ impl<T: Real> Sym3<T> {
             }
             p.dd = caps[2];
         }
-        p
     }
 
     /// The Joseph-form update (I − K e₁ᵀ) P (I − K e₁ᵀ)ᵀ + r K Kᵀ for the gain K = p/S worked
@@ -1343,6 +1342,16 @@ mod tests {
     }
 
     #[test]
+    fn the_floor_keeps_every_non_negative_value_exactly_and_cuts_the_rest_to_zero() {
+        for v in [0.0_f32, 1e-45, 3e-39, 1.2e-38, 1e-22, 1.0, 1.7e38] {
+            assert_eq!(non_negative(v).to_bits(), v.to_bits());
+        }
+        for v in [-1e-45_f32, -1e-22, -1.0, -3e38] {
+            assert_eq!(non_negative(v).to_bits(), 0);
+        }
+    }
+
+    #[test]
     fn caps_bound_the_covariance_and_never_raise_a_correlation() {
         let p = Sym3 {
             aa: 4.0,
@@ -1353,7 +1362,8 @@ mod tests {
             dd: 1e-10,
         };
         let caps = [1.0, 4e-6, 1e-12];
-        let c = p.capped(&caps);
+        let mut c = p;
+        c.cap(&caps);
         assert_eq!((c.aa, c.ww, c.dd), (1.0, 4e-6, 1e-12));
         let corr = |a: f64, b: f64, ab: f64| (ab / (a * b).sqrt()).abs();
         assert!(corr(c.aa, c.ww, c.aw) <= corr(p.aa, p.ww, p.aw));
@@ -1361,7 +1371,9 @@ mod tests {
         assert!(corr(c.ww, c.dd, c.wd) <= corr(p.ww, p.dd, p.wd));
         // Still positive definite: leading minors of the result.
         assert!(c.aa * c.ww - c.aw * c.aw > 0.0);
-        assert_eq!(p.capped(&[10.0, 1.0, 1.0]), p);
+        let mut c = p;
+        c.cap(&[10.0, 1.0, 1.0]);
+        assert_eq!(c, p);
     }
 
     #[test]
