@@ -97,12 +97,16 @@
 //! # Covariance
 //!
 //! The covariance is stored as its upper triangle, so it is symmetric by construction. The
-//! update is the Joseph form P⁺ = (I − KH) P⁻ (I − KH)ᵀ + K R Kᵀ, a sum of two positive
-//! semidefinite terms whatever rounding does to K (the short form (I − KH)P⁻ is not), written
-//! out for H = (1 0 0); its α row is evaluated as what it equals, R K (to second order in K's
-//! error, like the rest of the form), which keeps the digits the row written out loses by
-//! cancellation when P_αα⁻ ≫ R (see `Sym3::joseph`). Negative rounding residue on the
-//! diagonal is cut to zero (adding a
+//! update is P⁺ = P⁻ − K pᵀ for the gain K = p/S (p = P⁻ e₁, P⁻'s α column; S = P_αα⁻ + R),
+//! its α row evaluated as what it equals, R K (without the cancellation of p − P_αα⁻ K, which
+//! loses the digits when P_αα⁻ ≫ R), its (α̇, d) block as P_ij − p_i K_j (see `Sym3::posterior`).
+//! In exact arithmetic this is the Joseph form (I − KH) P⁻ (I − KH)ᵀ + K R Kᵀ for this gain.
+//! The Joseph form's advantage, that an error δ of K enters P⁺ at second order only, is below
+//! f32's resolution here: K is worked out from the same P⁻, so δ is K's own rounding, and the
+//! first-order term p_i δ_j is at most two roundings of √(P_ii P_jj) (|p_i K_i| ≤ P_ii), the
+//! size of the rounding the Joseph form itself carries in f32 (its correction c = p − S K is
+//! that rounding). What keeps P positive semidefinite in f32 is the same for both: negative
+//! rounding residue on the diagonal is cut to zero (adding a
 //! non-negative diagonal keeps P positive semidefinite). After each prediction a variance
 //! above its cap ([`ALPHA_VARIANCE_CAP_RAD2`], the initial α̇ and d variances) is brought back
 //! to the cap, its covariances scaled down with it (a congruence plus a non-negative diagonal,
@@ -115,15 +119,15 @@
 //!
 //! Plain scalars on the structure, not nalgebra matrices: Φ's d row is e₃ᵀ and P is symmetric,
 //! so Φ P Φᵀ is 30 multiply-adds on the 6 stored entries; Ψ and Φ share two polynomials of the
-//! series (12 operations), and the Joseph update for H = (1 0 0), regrouped, is 3 products and 8
+//! series (12 operations), and the update of P for H = (1 0 0) is 3 products and 3
 //! multiply-adds;
 //! one sin_cos (of 2α̂, lent by the law in the controller) and two divisions a step. On the
 //! Cortex-M4F (`examples/bench_estimator.rs`, flight profile, over the paper mission) a step
-//! takes 340 instructions with a sample (median; 355 at worst, in the first ticks, where the α̇
+//! takes 328 instructions with a sample (median; 343 at worst, in the first ticks, where the α̇
 //! variance sits at its cap), 268 in a dropout and 295 with a gated sample (355/370, 275 and 300
-//! before session 10's round; 408/445, 318 and 348 before issue 18's budget round); nalgebra's general 3×3 forms of the two covariance products
-//! alone take 815 (Φ P Φᵀ + Q) and 1 170 (Joseph)
-//! at opt-level "s".
+//! before session 10's round; 408/445, 318 and 348 before issue 18's budget round); nalgebra's
+//! general 3×3 forms of the two covariance products alone take 815 (Φ P Φᵀ + Q) and 1 170
+//! (Joseph) at opt-level "s".
 
 use crate::real::Real;
 
@@ -810,7 +814,7 @@ impl<T: Real> Estimator<T> {
         t.alpha = t.alpha + gain[0] * nu;
         t.rate = t.rate + gain[1] * nu;
         t.disturbance = t.disturbance + gain[2] * nu;
-        t.p = t.p.joseph(&gain, r);
+        t.p = t.p.posterior(&gain, r);
         t.rejections = 0;
         t.trig = None;
         Measurement::Accepted(innovation)
@@ -827,7 +831,7 @@ fn above_or_nan<T: Real>(v: T, cap: T) -> bool {
 /// is 2v or 0, and halving is exact). A NaN stays NaN. For the update's variances, finite and
 /// far below that (P⁻ within its caps, S ≥ R > 0).
 // Three operations without a comparison, where `if v >= 0` took five with its zero (three of
-// them in the Joseph update): scripts/bench-target, mission median/worst 880/903 → 875/898.
+// them in the update of P): scripts/bench-target, mission median/worst 880/903 → 875/898.
 fn non_negative<T: Real>(v: T) -> T {
     (v + v.abs()) * T::from_f64(0.5)
 }
@@ -976,41 +980,28 @@ impl<T: Real> Sym3<T> {
         }
     }
 
-    /// The Joseph-form update (I − K e₁ᵀ) P (I − K e₁ᵀ)ᵀ + r K Kᵀ for the gain K = p/S worked
-    /// out from this P (p = P e₁, P's α column; S = P_αα + r), by its upper triangle.
+    /// The covariance after a sample, P − K pᵀ for the gain K = p/S worked out from this P
+    /// (p = P e₁, P's α column; S = P_αα + r), by its upper triangle (module docs,
+    /// *Covariance*: for this gain it is the Joseph form, to f32's resolution).
     ///
-    /// α's row is r K. For H = e₁ the Joseph form's α row is (1 − K_α)(p − P_αα K) + r K_α K,
-    /// which equals r p/S up to second order in an error δ of K (S δδᵀ terms, as everywhere in
-    /// the Joseph form), and r K is r p/S to the rounding of K (two roundings of each entry).
-    /// The row written out, p − P_αα K − K_α c, cancels to r/S of p, so where P_αα ≫ r (the
-    /// first sample after a dropout) it lost about S/r roundings of p that r K keeps; and
-    /// P⁺_αα = r K_α is non-negative wherever P_αα is (and cut to zero otherwise, as the block's
-    /// diagonal).
-    ///
-    /// The (α̇, d) block is the Joseph form's, P − K pᵀ − p Kᵀ + S K Kᵀ, evaluated as
-    ///
-    /// ```text
-    ///   P⁺_ij = P_ij − K_i c_j − p_i K_j,    c = p − S K,
-    /// ```
-    ///
-    /// the same expression regrouped: c is K's own error (0 for the exact gain p/S), so an
-    /// error δ in K still enters P⁺ only at second order (S δδᵀ), which is what the Joseph form
-    /// is for; the short form P − K pᵀ is first order in δ. Negative rounding residue on its
-    /// diagonal is cut to zero.
-    // 3 products and 8 multiply-adds with 3 floors where the whole Joseph form regrouped took
-    // 15 multiply-adds with 3 floors (and 27 written out): scripts/bench-target, mission
-    // median/worst 895/918 → 888/910.
-    fn joseph(&self, k: &[T; 3], r: T) -> Self {
+    /// α's row is r K, what p − P_αα K equals (p(1 − P_αα/S) = r p/S): evaluated as written,
+    /// that difference cancels to r/S of p, and where P_αα ≫ r (the first sample after a
+    /// dropout) it lost every digit (to 0 in f32 at P_αα = 10⁸ r); r K is within two roundings.
+    /// P⁺_αα = r K_α is non-negative wherever P_αα is. The (α̇, d) block is P_ij − p_i K_j.
+    /// Negative rounding residue on the diagonal is cut to zero.
+    // The Joseph form, regrouped (P_ij − K_i c_j − p_i K_j, c = p − S K), took 15 multiply-adds;
+    // its α row as r K, 3 products and 8 multiply-adds (scripts/bench-target, mission
+    // median/worst 895/918 → 888/910); the block as P_ij − p_i K_j, 3 multiply-adds
+    // (873/893 → 865/885).
+    fn posterior(&self, k: &[T; 3], r: T) -> Self {
         let p = self;
-        let s = p.aa + r;
-        let c = [p.aw - s * k[1], p.ad - s * k[2]];
         Self {
             aa: non_negative(r * k[0]),
             aw: r * k[1],
             ad: r * k[2],
-            ww: non_negative(p.ww - k[1] * c[0] - p.aw * k[1]),
-            wd: p.wd - k[1] * c[1] - p.aw * k[2],
-            dd: non_negative(p.dd - k[2] * c[1] - p.ad * k[2]),
+            ww: non_negative(p.ww - p.aw * k[1]),
+            wd: p.wd - p.aw * k[2],
+            dd: non_negative(p.dd - p.ad * k[2]),
         }
     }
 }
@@ -1280,7 +1271,7 @@ mod tests {
     }
 
     #[test]
-    fn joseph_update_keeps_the_covariance_symmetric_positive() {
+    fn the_update_keeps_the_covariance_symmetric_positive() {
         let p = Sym3 {
             aa: 1e-8,
             aw: 9.9e-12,
@@ -1292,8 +1283,8 @@ mod tests {
         let r = 1e-8_f64;
         let inv = 1.0 / (p.aa + r);
         let k = [p.aa * inv, p.aw * inv, p.ad * inv];
-        let j = p.joseph(&k, r);
-        // Against the short form P − K S Kᵀ.
+        let j = p.posterior(&k, r);
+        // Against P − K S Kᵀ, the same in exact arithmetic.
         let s = p.aa + r;
         let short = [
             p.aa - k[0] * k[0] * s,
@@ -1308,10 +1299,11 @@ mod tests {
     }
 
     #[test]
-    fn joseph_update_keeps_the_alpha_row_accurate_after_a_dropout() {
+    fn the_update_keeps_the_alpha_row_accurate_after_a_dropout() {
         // P_αα at its cap, a million times R: the α row of the posterior, r p/S, is 1e-8 of
-        // p. Evaluated as the Joseph form's p − P_αα K − K_α c it cancelled to nothing in
-        // f32 (P_αα K_α̇ rounds to P_αα̇ itself); as r K it is within a few roundings.
+        // p. Evaluated as written, p − P_αα K (or as the Joseph form's p − P_αα K − K_α c), it
+        // cancelled to nothing in f32 (P_αα K_α̇ rounds to P_αα̇ itself); as r K it is within a
+        // few roundings.
         let p = Sym3::<f32> {
             aa: 1.0,
             aw: 1.5e-3,
@@ -1323,7 +1315,7 @@ mod tests {
         let r = 1e-8_f32;
         let inv = 1.0 / (p.aa + r);
         let k = [p.aa * inv, p.aw * inv, p.ad * inv];
-        let j = p.joseph(&k, r);
+        let j = p.posterior(&k, r);
         let s = f64::from(p.aa) + f64::from(r);
         let exact = |p_i: f32| f64::from(r) * f64::from(p_i) / s;
         for (got, p_i) in [(j.aa, p.aa), (j.aw, p.aw), (j.ad, p.ad)] {
