@@ -74,8 +74,11 @@ pub(super) struct Estimation<T: Real> {
     /// terms are in range by construction (see [`Estimation::new`]), all otherwise.
     checks: DriveChecks,
     /// The orbit's terms at the last accepted sample (a period without one is carried with
-    /// them).
-    orbit: Option<OrbitTerms<T>>,
+    /// them); before the first, the configured orbit's at periapsis (no estimate to carry
+    /// then: the estimate starts from an accepted sample's α).
+    // Not an `Option`: its tag stored every step and tested by every prediction cost 5
+    // instructions a step (scripts/bench-target, mission median/worst 865/885 → 858/880).
+    orbit: OrbitTerms<T>,
     /// What the last step commanded (`None` before the first step).
     commanded: Option<Commanded<T>>,
     /// The NIS of the last step's α sample, if one met the estimate.
@@ -117,7 +120,11 @@ impl<T: Real> Estimation<T> {
             eccentric,
             max_alpha_var_rad2,
             checks,
-            orbit: None,
+            orbit: OrbitTerms {
+                rate_radps: orbit.true_anomaly_rate_radps(T::ZERO),
+                accel_radps2: orbit.true_anomaly_accel_radps2(T::ZERO),
+                gravity_gradient_per_s2: orbit.gravity_gradient_per_s2(T::ZERO),
+            },
             commanded: None,
             nis: None,
             useless: false,
@@ -165,7 +172,7 @@ impl<T: Real> Estimation<T> {
     ) -> (Estimated<T>, Option<EventKind>) {
         let mut reel_rate_mps = None;
         if let Some((orbit_rate_radps, true_anomaly_rad, measured)) = sample {
-            self.orbit = Some(self.orbit_terms(orbit_rate_radps, true_anomaly_rad));
+            self.orbit = self.orbit_terms(orbit_rate_radps, true_anomaly_rad);
             reel_rate_mps = measured;
         }
         let lost = if periods > MAX_CARRIED_PERIODS {
@@ -264,10 +271,10 @@ impl<T: Real> Estimation<T> {
     /// The drive of the `k`-th period since the last step: the last step's command, its length
     /// advanced by k periods of it; the rate measured over the period when the encoder gave
     /// one (taken as the period's mean: the drive's rate at mid-period, so its start rate is
-    /// the mean less half the period's commanded change). `None` without a command or orbit
-    /// terms yet (then there is no estimate to carry either).
+    /// the mean less half the period's commanded change). `None` without a command yet
+    /// (the estimate is then dropped: nothing says how the reel moved).
     fn drive(&self, k: u32, reel_rate_mps: Option<T>) -> Option<Drive<T>> {
-        let (c, o) = (self.commanded?, self.orbit?);
+        let (c, o) = (self.commanded?, self.orbit);
         let h = self.filter.config().period_s;
         let rate_mps = match reel_rate_mps {
             Some(mean) => mean - T::from_f64(0.5) * c.accel_mps2 * h,
@@ -343,7 +350,7 @@ mod tests {
         let cfg = estimator::Config::<f64>::paper();
         let mut e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), RATES).unwrap();
         assert_eq!(e.drive(0, None), None);
-        e.orbit = Some(e.orbit_terms(1.06e-3, 0.0));
+        e.orbit = e.orbit_terms(1.06e-3, 0.0);
         let c = Commanded {
             length_m: 100.0,
             rate_mps: 2.0,
