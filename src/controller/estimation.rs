@@ -200,17 +200,17 @@ impl<T: Real> Estimation<T> {
         } else {
             event
         };
-        if matches!(
+        // An α used now makes the estimate worth judging again.
+        let used = matches!(
             m,
             Measurement::Accepted(_) | Measurement::Initialised | Measurement::Reinitialised(_)
-        ) {
-            self.useless = false;
-        }
+        );
         let verdict = match (m, estimate) {
             (Measurement::Gated(_), _) => Estimated::Unusable(Sensor::AlphaGated),
             (_, Some((alpha_rad, alpha_rate_radps, alpha_var_rad2)))
-                if !self.useless && alpha_var_rad2 <= self.max_alpha_var_rad2 =>
+                if (used || !self.useless) && alpha_var_rad2 <= self.max_alpha_var_rad2 =>
             {
+                self.useless = false;
                 Estimated::Usable(alpha_rad, alpha_rate_radps)
             }
             _ => {
