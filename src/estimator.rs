@@ -105,9 +105,10 @@
 //! f32's resolution here: K is worked out from the same P⁻, so δ is K's own rounding, and the
 //! first-order term p_i δ_j is at most two roundings of √(P_ii P_jj) (|p_i K_i| ≤ P_ii), the
 //! size of the rounding the Joseph form itself carries in f32 (its correction c = p − S K is
-//! that rounding). What keeps P positive semidefinite in f32 is the same for both: negative
-//! rounding residue on the diagonal is cut to zero (adding a
-//! non-negative diagonal keeps P positive semidefinite). After each prediction a variance
+//! that rounding). What keeps P positive semidefinite in f32 is the same for both
+//! (`tests/estimator.rs::updates_after_dropouts_of_any_length_keep_the_covariance_positive_definite`):
+//! negative rounding residue on the diagonal is cut to zero (adding a non-negative diagonal
+//! keeps P positive semidefinite), and the rounding load below. After each prediction a variance
 //! above its cap ([`ALPHA_VARIANCE_CAP_RAD2`], the initial α̇ and d variances) is brought back
 //! to the cap, its covariances scaled down with it (a congruence plus a non-negative diagonal,
 //! which keeps P positive semidefinite), so a dropout of any length cannot overflow f32 and
