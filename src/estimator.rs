@@ -107,8 +107,9 @@
 //! size of the rounding the Joseph form itself carries in f32 (its correction c = p − S K is
 //! that rounding). What keeps P positive semidefinite in f32 is the same for both
 //! (`tests/estimator.rs::updates_after_dropouts_of_any_length_keep_the_covariance_positive_definite`):
-//! negative rounding residue on the diagonal is cut to zero (adding a non-negative diagonal
-//! keeps P positive semidefinite), and the rounding load below. After each prediction a variance
+//! a negative rounding residue v on the diagonal becomes |v| (the residue cut to zero, plus the
+//! non-negative diagonal |v|: positive semidefinite wherever the cut one is, and never less
+//! certain), and the rounding load below. After each prediction a variance
 //! above its cap ([`ALPHA_VARIANCE_CAP_RAD2`], the initial α̇ and d variances) is brought back
 //! to the cap, its covariances scaled down with it (a congruence plus a non-negative diagonal,
 //! which keeps P positive semidefinite), so a dropout of any length cannot overflow f32 and
@@ -124,7 +125,7 @@
 //! multiply-adds;
 //! one sin_cos (of 2α̂, lent by the law in the controller) and two divisions a step. On the
 //! Cortex-M4F (`examples/bench_estimator.rs`, flight profile, over the paper mission) a step
-//! takes 328 instructions with a sample (median; 343 at worst, in the first ticks, where the α̇
+//! takes 320 instructions with a sample (median; 335 at worst, in the first ticks, where the α̇
 //! variance sits at its cap), 268 in a dropout and 295 with a gated sample (355/370, 275 and 300
 //! before session 10's round; 408/445, 318 and 348 before issue 18's budget round); nalgebra's
 //! general 3×3 forms of the two covariance products alone take 815 (Φ P Φᵀ + Q) and 1 170
@@ -828,15 +829,6 @@ fn above_or_nan<T: Real>(v: T, cap: T) -> bool {
     !(v <= cap)
 }
 
-/// `v` if it is at least 0, else +0: (v + |v|)/2, exact below half the largest float (v + |v|
-/// is 2v or 0, and halving is exact). A NaN stays NaN. For the update's variances, finite and
-/// far below that (P⁻ within its caps, S ≥ R > 0).
-// Three operations without a comparison, where `if v >= 0` took five with its zero (three of
-// them in the update of P): scripts/bench-target, mission median/worst 880/903 → 875/898.
-fn non_negative<T: Real>(v: T) -> T {
-    (v + v.abs()) * T::from_f64(0.5)
-}
-
 /// Which input of a refused drive is at fault (in the order of [`DriveInput`]), `u` = s h.
 fn refusal<T: Real>(drive: &Drive<T>, u: T) -> DriveError {
     let f = T::from_f64;
@@ -988,8 +980,11 @@ impl<T: Real> Sym3<T> {
     /// α's row is r K, what p − P_αα K equals (p(1 − P_αα/S) = r p/S): evaluated as written,
     /// that difference cancels to r/S of p, and where P_αα ≫ r (the first sample after a
     /// dropout) it lost every digit (to 0 in f32 at P_αα = 10⁸ r); r K is within two roundings.
-    /// P⁺_αα = r K_α is non-negative wherever P_αα is. The (α̇, d) block is P_ij − p_i K_j.
-    /// Negative rounding residue on the diagonal is cut to zero.
+    /// The (α̇, d) block is P_ij − p_i K_j. A negative rounding residue on the diagonal becomes
+    /// its magnitude (module docs).
+    // The diagonal's |v| where the cut to zero took three operations each as (v + |v|)/2 (five
+    // with a comparison): mission median/worst 880/903 → 875/898 with (v + |v|)/2, then
+    // 855/878 → 848/870 with |v| (scripts/bench-target).
     // The Joseph form, regrouped (P_ij − K_i c_j − p_i K_j, c = p − S K), took 15 multiply-adds;
     // its α row as r K, 3 products and 8 multiply-adds (scripts/bench-target, mission
     // median/worst 895/918 → 888/910); the block as P_ij − p_i K_j, 3 multiply-adds
@@ -997,12 +992,12 @@ impl<T: Real> Sym3<T> {
     fn posterior(&self, k: &[T; 3], r: T) -> Self {
         let p = self;
         Self {
-            aa: non_negative(r * k[0]),
+            aa: (r * k[0]).abs(),
             aw: r * k[1],
             ad: r * k[2],
-            ww: non_negative(p.ww - p.aw * k[1]),
+            ww: (p.ww - p.aw * k[1]).abs(),
             wd: p.wd - p.aw * k[2],
-            dd: non_negative(p.dd - p.ad * k[2]),
+            dd: (p.dd - p.ad * k[2]).abs(),
         }
     }
 }
@@ -1335,13 +1330,26 @@ mod tests {
     }
 
     #[test]
-    fn the_floor_keeps_every_non_negative_value_exactly_and_cuts_the_rest_to_zero() {
-        for v in [0.0_f32, 1e-45, 3e-39, 1.2e-38, 1e-22, 1.0, 1.7e38] {
-            assert_eq!(non_negative(v).to_bits(), v.to_bits());
-        }
-        for v in [-1e-45_f32, -1e-22, -1.0, -3e38] {
-            assert_eq!(non_negative(v).to_bits(), 0);
-        }
+    fn a_negative_residue_on_the_diagonal_becomes_its_magnitude() {
+        // A P⁻ a rounding beyond semidefinite (Cov(α, α̇)² just above P_αα P_α̇α̇): the α̇
+        // variance the update leaves is negative as computed, and is kept as its magnitude,
+        // never below the zero a cut would leave; the other entries are as computed.
+        let p = Sym3 {
+            aa: 1e-8,
+            aw: 1.5e-11,
+            ad: 1e-15,
+            ww: 1e-14,
+            wd: 9e-19,
+            dd: 1e-22,
+        };
+        let r = 1e-8_f64;
+        let inv = 1.0 / (p.aa + r);
+        let k = [p.aa * inv, p.aw * inv, p.ad * inv];
+        let j = p.posterior(&k, r);
+        let ww = p.ww - p.aw * k[1];
+        assert!(ww < 0.0);
+        assert_eq!(j.ww, -ww);
+        assert_eq!((j.aa, j.dd), (r * k[0], p.dd - p.ad * k[2]));
     }
 
     #[test]
