@@ -176,16 +176,21 @@ impl<T: Real> Estimation<T> {
             self.sense_orbit(orbit_rate_radps, true_anomaly_rad);
             reel_rate_mps = measured;
         }
-        let lost = if periods > MAX_CARRIED_PERIODS {
-            let had = self.filter.estimate().is_some();
-            self.filter.reset();
-            had
-        } else {
-            // The periods before the last (a gap in the calls), then the last one, with the
-            // encoder's rate (that of the period that just ended).
-            let gap_lost = periods > 1 && self.carry_gap(periods - 1);
-            let last_lost = periods > 0 && self.carry(periods - 1, reel_rate_mps);
-            gap_lost || last_lost
+        // The last period with the encoder's rate (that of the period that just ended), after
+        // the periods of a gap in the calls. One period, the common case, tested first.
+        let lost = match periods {
+            1 => self.carry(0, reel_rate_mps),
+            0 => false,
+            2..=MAX_CARRIED_PERIODS => {
+                let gap_lost = self.carry_gap(periods - 1);
+                let last_lost = self.carry(periods - 1, reel_rate_mps);
+                gap_lost || last_lost
+            }
+            _ => {
+                let had = self.filter.estimate().is_some();
+                self.filter.reset();
+                had
+            }
         };
         // The monitor checked α: |α| ≤ π.
         let m = self.filter.update_with_angle(alpha_rad);
