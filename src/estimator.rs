@@ -97,10 +97,19 @@
 //! # Covariance
 //!
 //! The covariance is stored as its upper triangle, so it is symmetric by construction. The
-//! update is the Joseph form P⁺ = (I − KH) P⁻ (I − KH)ᵀ + K R Kᵀ, a sum of two positive
-//! semidefinite terms whatever rounding does to K (the short form (I − KH)P⁻ is not), written
-//! out for H = (1 0 0). Negative rounding residue on the diagonal is cut to zero (adding a
-//! non-negative diagonal keeps P positive semidefinite). After each prediction a variance
+//! update is P⁺ = P⁻ − K pᵀ for the gain K = p/S (p = P⁻ e₁, P⁻'s α column; S = P_αα⁻ + R),
+//! its α row evaluated as what it equals, R K (without the cancellation of p − P_αα⁻ K, which
+//! loses the digits when P_αα⁻ ≫ R), its (α̇, d) block as P_ij − p_i K_j (see `Sym3::posterior`).
+//! In exact arithmetic this is the Joseph form (I − KH) P⁻ (I − KH)ᵀ + K R Kᵀ for this gain.
+//! The Joseph form's advantage, that an error δ of K enters P⁺ at second order only, is below
+//! f32's resolution here: K is worked out from the same P⁻, so δ is K's own rounding, and the
+//! first-order term p_i δ_j is at most two roundings of √(P_ii P_jj) (|p_i K_i| ≤ P_ii), the
+//! size of the rounding the Joseph form itself carries in f32 (its correction c = p − S K is
+//! that rounding). What keeps P positive semidefinite in f32 is the same for both
+//! (`tests/estimator.rs::updates_after_dropouts_of_any_length_keep_the_covariance_positive_definite`):
+//! a negative rounding residue v on the diagonal becomes |v| (the residue cut to zero, plus the
+//! non-negative diagonal |v|: positive semidefinite wherever the cut one is, and never less
+//! certain), and the rounding load below. After each prediction a variance
 //! above its cap ([`ALPHA_VARIANCE_CAP_RAD2`], the initial α̇ and d variances) is brought back
 //! to the cap, its covariances scaled down with it (a congruence plus a non-negative diagonal,
 //! which keeps P positive semidefinite), so a dropout of any length cannot overflow f32 and
@@ -112,14 +121,15 @@
 //!
 //! Plain scalars on the structure, not nalgebra matrices: Φ's d row is e₃ᵀ and P is symmetric,
 //! so Φ P Φᵀ is 30 multiply-adds on the 6 stored entries; Ψ and Φ share two polynomials of the
-//! series (12 operations), and the Joseph update for H = (1 0 0), regrouped, is 15 multiply-adds;
+//! series (12 operations), and the update of P for H = (1 0 0) is 3 products and 3
+//! multiply-adds;
 //! one sin_cos (of 2α̂, lent by the law in the controller) and two divisions a step. On the
 //! Cortex-M4F (`examples/bench_estimator.rs`, flight profile, over the paper mission) a step
-//! takes 355 instructions with a sample (median; 370 at worst, in the first ticks, where the α̇
-//! variance sits at its cap), 275 in a dropout and 300 with a gated sample (408/445, 318 and 348
-//! before issue 18's budget round); nalgebra's general 3×3 forms of the two covariance products
-//! alone take 815 (Φ P Φᵀ + Q) and 1 170 (Joseph)
-//! at opt-level "s".
+//! takes 320 instructions with a sample (median; 335 at worst, in the first ticks, where the α̇
+//! variance sits at its cap), 268 in a dropout and 295 with a gated sample (355/370, 275 and 300
+//! before session 10's round; 408/445, 318 and 348 before issue 18's budget round); nalgebra's
+//! general 3×3 forms of the two covariance products alone take 815 (Φ P Φᵀ + Q) and 1 170
+//! (Joseph) at opt-level "s".
 
 use crate::real::Real;
 
@@ -581,7 +591,10 @@ impl<T: Real> Estimator<T> {
             None => Prediction::NoEstimate,
             Some(track) => match self.predict(track, drive, checks) {
                 Ok(next) => {
-                    self.track = Some(next);
+                    // Capped where it is kept: the common case, no cap reached, then stores the
+                    // predicted covariance as it is, where a capped copy was merged with it
+                    // (mission median/worst 875/898 → 873/893, scripts/bench-target).
+                    self.track.insert(next).p.cap(&self.caps);
                     Prediction::Predicted
                 }
                 Err(p) => {
@@ -631,6 +644,14 @@ impl<T: Real> Estimator<T> {
             if t.alpha == alpha_rad {
                 t.trig = Some((sin_two_alpha, cos_two_alpha));
             }
+        }
+    }
+
+    /// [`Estimator::lend_sin_cos_two_alpha`] for a caller that computed them for the estimate's
+    /// α̂ itself (the controller's law, which flies on it): no comparison of the angles.
+    pub(crate) fn lend_sin_cos_two_alpha_hat(&mut self, sin_two_alpha: T, cos_two_alpha: T) {
+        if let Some(t) = &mut self.track {
+            t.trig = Some((sin_two_alpha, cos_two_alpha));
         }
     }
 
@@ -696,7 +717,8 @@ impl<T: Real> Estimator<T> {
         }
     }
 
-    /// The estimate and covariance carried over one period (module docs, *Discretisation*).
+    /// The estimate and covariance carried over one period (module docs, *Discretisation*),
+    /// before the caps (which the caller applies in place, `Sym3::cap`).
     fn predict(
         &self,
         t: &Track<T>,
@@ -738,18 +760,21 @@ impl<T: Real> Estimator<T> {
         // x⁺ = x + h Ψ f(x): α⁺ = α + h(Ψ_αα α̇ + h w α̈), α̇⁺ = (1 − k w) α̇ + h ψ α̈.
         let alpha = t.alpha + h * (psi_aa * t.rate + h * w * accel);
         let rate = phi_aa * t.rate + h_psi * accel;
-        if !(rate.abs() <= f(MAX_ALPHA_RATE_RADPS) && alpha.is_finite()) {
+        // α̇⁺ bounds α⁺: h ψ α̈ = α̇⁺ − (1 − k w) α̇, so
+        //   α⁺ − α = h Ψ_αα α̇ + (h w/ψ)(α̇⁺ − (1 − k w) α̇),
+        // a few h at most for |α̇|, |α̇⁺| ≤ 1 (|u| ≤ 1/2 and |k| < 0.1 keep ψ near 1, w near 1/2);
+        // α̂ starts and is updated within [−π, π] plus a gated innovation. A NaN or an infinity
+        // in the state or the drive reaches α̇⁺, so its test alone finds a diverged estimate.
+        // (α̂'s own `is_finite` took 8 instructions: scripts/bench-target, mission median/worst
+        // 888/910 → 880/903.)
+        if above_or_nan(rate.abs(), f(MAX_ALPHA_RATE_RADPS)) {
             return Err(Prediction::Diverged);
         }
         let phi = [
             [phi_aa, h_psi, self.period_sq_s2 * w],
             [-(stiffness * h * psi), phi_aa - u * psi, h_psi],
         ];
-        let p =
-            t.p.propagated(&phi)
-                .rounding_loaded()
-                .plus(&self.process)
-                .capped(&self.caps);
+        let p = t.p.propagated(&phi).rounding_loaded().plus(&self.process);
         Ok(Track {
             alpha,
             rate,
@@ -791,7 +816,7 @@ impl<T: Real> Estimator<T> {
         t.alpha = t.alpha + gain[0] * nu;
         t.rate = t.rate + gain[1] * nu;
         t.disturbance = t.disturbance + gain[2] * nu;
-        t.p = t.p.joseph(&gain, r);
+        t.p = t.p.posterior(&gain, r);
         t.rejections = 0;
         t.trig = None;
         Measurement::Accepted(innovation)
@@ -802,15 +827,6 @@ impl<T: Real> Estimator<T> {
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN is meant to count as above
 fn above_or_nan<T: Real>(v: T, cap: T) -> bool {
     !(v <= cap)
-}
-
-/// `v` if it is at least 0, else 0 (NaN included): `v.max(0)` in one comparison.
-fn non_negative<T: Real>(v: T) -> T {
-    if v >= T::ZERO {
-        v
-    } else {
-        T::ZERO
-    }
 }
 
 /// Which input of a refused drive is at fault (in the order of [`DriveInput`]), `u` = s h.
@@ -926,10 +942,10 @@ impl<T: Real> Sym3<T> {
     // variance sits at its cap, took 45 instructions more than a nominal step with the three
     // ratios worked out together (tools/trace_profile.py --mission-tick 1). The products are
     // those of D P D in the same order, so the result is the same to the bit.
-    fn capped(&self, caps: &[T; 3]) -> Self {
-        let mut p = *self;
+    fn cap(&mut self, caps: &[T; 3]) {
+        let p = self;
         if p.aa <= caps[0] && p.ww <= caps[1] && p.dd <= caps[2] {
-            return p;
+            return;
         }
         if above_or_nan(p.aa, caps[0]) {
             if p.aa > caps[0] {
@@ -955,32 +971,33 @@ impl<T: Real> Sym3<T> {
             }
             p.dd = caps[2];
         }
-        p
     }
 
-    /// The Joseph-form update (I − K e₁ᵀ) P (I − K e₁ᵀ)ᵀ + r K Kᵀ, by its upper triangle.
-    /// With p = P e₁ (P's α column) and S = P_αα + r, it expands to P − K pᵀ − p Kᵀ + S K Kᵀ,
-    /// evaluated as
+    /// The covariance after a sample, P − K pᵀ for the gain K = p/S worked out from this P
+    /// (p = P e₁, P's α column; S = P_αα + r), by its upper triangle (module docs,
+    /// *Covariance*: for this gain it is the Joseph form, to f32's resolution).
     ///
-    /// ```text
-    ///   P⁺_ij = P_ij − K_i c_j − p_i K_j,    c = p − S K,
-    /// ```
-    ///
-    /// the same expression regrouped: c is K's own error (0 for the exact gain p/S), so an
-    /// error δ in K still enters P⁺ only at second order (S δδᵀ), which is what the Joseph form
-    /// is for; the short form P − K pᵀ is first order in δ. 15 multiply-adds where the product
-    /// written out took 27. Negative rounding residue on the diagonal is cut to zero.
-    fn joseph(&self, k: &[T; 3], r: T) -> Self {
+    /// α's row is r K, what p − P_αα K equals (p(1 − P_αα/S) = r p/S): evaluated as written,
+    /// that difference cancels to r/S of p, and where P_αα ≫ r (the first sample after a
+    /// dropout) it lost every digit (to 0 in f32 at P_αα = 10⁸ r); r K is within two roundings.
+    /// The (α̇, d) block is P_ij − p_i K_j. A negative rounding residue on the diagonal becomes
+    /// its magnitude (module docs).
+    // The diagonal's |v| where the cut to zero took three operations each as (v + |v|)/2 (five
+    // with a comparison): mission median/worst 880/903 → 875/898 with (v + |v|)/2, then
+    // 855/878 → 848/870 with |v| (scripts/bench-target).
+    // The Joseph form, regrouped (P_ij − K_i c_j − p_i K_j, c = p − S K), took 15 multiply-adds;
+    // its α row as r K, 3 products and 8 multiply-adds (scripts/bench-target, mission
+    // median/worst 895/918 → 888/910); the block as P_ij − p_i K_j, 3 multiply-adds
+    // (873/893 → 865/885).
+    fn posterior(&self, k: &[T; 3], r: T) -> Self {
         let p = self;
-        let s = p.aa + r;
-        let c = [p.aa - s * k[0], p.aw - s * k[1], p.ad - s * k[2]];
         Self {
-            aa: non_negative(p.aa - k[0] * c[0] - p.aa * k[0]),
-            aw: p.aw - k[0] * c[1] - p.aa * k[1],
-            ad: p.ad - k[0] * c[2] - p.aa * k[2],
-            ww: non_negative(p.ww - k[1] * c[1] - p.aw * k[1]),
-            wd: p.wd - k[1] * c[2] - p.aw * k[2],
-            dd: non_negative(p.dd - k[2] * c[2] - p.ad * k[2]),
+            aa: (r * k[0]).abs(),
+            aw: r * k[1],
+            ad: r * k[2],
+            ww: (p.ww - p.aw * k[1]).abs(),
+            wd: p.wd - p.aw * k[2],
+            dd: (p.dd - p.ad * k[2]).abs(),
         }
     }
 }
@@ -1250,7 +1267,7 @@ mod tests {
     }
 
     #[test]
-    fn joseph_update_keeps_the_covariance_symmetric_positive() {
+    fn the_update_keeps_the_covariance_symmetric_positive() {
         let p = Sym3 {
             aa: 1e-8,
             aw: 9.9e-12,
@@ -1262,8 +1279,8 @@ mod tests {
         let r = 1e-8_f64;
         let inv = 1.0 / (p.aa + r);
         let k = [p.aa * inv, p.aw * inv, p.ad * inv];
-        let j = p.joseph(&k, r);
-        // Against the short form P − K S Kᵀ.
+        let j = p.posterior(&k, r);
+        // Against P − K S Kᵀ, the same in exact arithmetic.
         let s = p.aa + r;
         let short = [
             p.aa - k[0] * k[0] * s,
@@ -1278,6 +1295,64 @@ mod tests {
     }
 
     #[test]
+    fn the_update_keeps_the_alpha_row_accurate_after_a_dropout() {
+        // P_αα at its cap, a million times R: the α row of the posterior, r p/S, is 1e-8 of
+        // p. Evaluated as written, p − P_αα K (or as the Joseph form's p − P_αα K − K_α c), it
+        // cancelled to nothing in f32 (P_αα K_α̇ rounds to P_αα̇ itself); as r K it is within a
+        // few roundings.
+        let p = Sym3::<f32> {
+            aa: 1.0,
+            aw: 1.5e-3,
+            ad: 8e-7,
+            ww: 4e-6,
+            wd: 1.9e-9,
+            dd: 1e-12,
+        };
+        let r = 1e-8_f32;
+        let inv = 1.0 / (p.aa + r);
+        let k = [p.aa * inv, p.aw * inv, p.ad * inv];
+        let j = p.posterior(&k, r);
+        let s = f64::from(p.aa) + f64::from(r);
+        let exact = |p_i: f32| f64::from(r) * f64::from(p_i) / s;
+        for (got, p_i) in [(j.aa, p.aa), (j.aw, p.aw), (j.ad, p.ad)] {
+            let want = exact(p_i);
+            assert!(
+                (f64::from(got) - want).abs() <= 4.0 * f64::from(f32::EPSILON) * want.abs(),
+                "{got} vs {want}"
+            );
+        }
+        // The (α̇, d) block is the Schur complement's: positive, the correlations kept below 1.
+        assert!(
+            j.ww > 0.0 && j.dd > 0.0 && j.ww * j.dd > j.wd * j.wd,
+            "{j:?}"
+        );
+        assert!(j.aa * j.ww > j.aw * j.aw, "{j:?}");
+    }
+
+    #[test]
+    fn a_negative_residue_on_the_diagonal_becomes_its_magnitude() {
+        // A P⁻ a rounding beyond semidefinite (Cov(α, α̇)² just above P_αα P_α̇α̇): the α̇
+        // variance the update leaves is negative as computed, and is kept as its magnitude,
+        // never below the zero a cut would leave; the other entries are as computed.
+        let p = Sym3 {
+            aa: 1e-8,
+            aw: 1.5e-11,
+            ad: 1e-15,
+            ww: 1e-14,
+            wd: 9e-19,
+            dd: 1e-22,
+        };
+        let r = 1e-8_f64;
+        let inv = 1.0 / (p.aa + r);
+        let k = [p.aa * inv, p.aw * inv, p.ad * inv];
+        let j = p.posterior(&k, r);
+        let ww = p.ww - p.aw * k[1];
+        assert!(ww < 0.0);
+        assert_eq!(j.ww, -ww);
+        assert_eq!((j.aa, j.dd), (r * k[0], p.dd - p.ad * k[2]));
+    }
+
+    #[test]
     fn caps_bound_the_covariance_and_never_raise_a_correlation() {
         let p = Sym3 {
             aa: 4.0,
@@ -1288,7 +1363,8 @@ mod tests {
             dd: 1e-10,
         };
         let caps = [1.0, 4e-6, 1e-12];
-        let c = p.capped(&caps);
+        let mut c = p;
+        c.cap(&caps);
         assert_eq!((c.aa, c.ww, c.dd), (1.0, 4e-6, 1e-12));
         let corr = |a: f64, b: f64, ab: f64| (ab / (a * b).sqrt()).abs();
         assert!(corr(c.aa, c.ww, c.aw) <= corr(p.aa, p.ww, p.aw));
@@ -1296,7 +1372,9 @@ mod tests {
         assert!(corr(c.ww, c.dd, c.wd) <= corr(p.ww, p.dd, p.wd));
         // Still positive definite: leading minors of the result.
         assert!(c.aa * c.ww - c.aw * c.aw > 0.0);
-        assert_eq!(p.capped(&[10.0, 1.0, 1.0]), p);
+        let mut c = p;
+        c.cap(&[10.0, 1.0, 1.0]);
+        assert_eq!(c, p);
     }
 
     #[test]

@@ -74,8 +74,11 @@ pub(super) struct Estimation<T: Real> {
     /// terms are in range by construction (see [`Estimation::new`]), all otherwise.
     checks: DriveChecks,
     /// The orbit's terms at the last accepted sample (a period without one is carried with
-    /// them).
-    orbit: Option<OrbitTerms<T>>,
+    /// them); before the first, the configured orbit's at periapsis (no estimate to carry
+    /// then: the estimate starts from an accepted sample's α).
+    // Not an `Option`: its tag stored every step and tested by every prediction cost 5
+    // instructions a step (scripts/bench-target, mission median/worst 865/885 → 858/880).
+    orbit: OrbitTerms<T>,
     /// What the last step commanded (`None` before the first step).
     commanded: Option<Commanded<T>>,
     /// The NIS of the last step's α sample, if one met the estimate.
@@ -117,7 +120,12 @@ impl<T: Real> Estimation<T> {
             eccentric,
             max_alpha_var_rad2,
             checks,
-            orbit: None,
+            orbit: OrbitTerms {
+                rate_radps: orbit.true_anomaly_rate_radps(T::ZERO),
+                // sin θ = 0 at periapsis; 0 for good on a circular orbit (`sense_orbit`).
+                accel_radps2: T::ZERO,
+                gravity_gradient_per_s2: orbit.gravity_gradient_per_s2(T::ZERO),
+            },
             commanded: None,
             nis: None,
             useless: false,
@@ -129,10 +137,18 @@ impl<T: Real> Estimation<T> {
         self.filter.estimate()
     }
 
-    /// The law computed sin 2α and cos 2α for `alpha_rad` (the estimate's α̂): the next
-    /// prediction reuses them.
+    /// The law computed sin 2α and cos 2α for `alpha_rad`, the α̂ of this step's
+    /// [`Estimated::Usable`] verdict: the next prediction reuses them.
+    // The law flies on the verdict's α̂ and nothing moves the estimate between the verdict and
+    // this call, so the filter need not compare the angles (a debug assertion does): the
+    // comparison (and the angle kept across the law for it) took 3 instructions a step
+    // (scripts/bench-target, mission median 898 → 895).
     pub(super) fn lend_sin_cos_two_alpha(&mut self, alpha_rad: T, sin: T, cos: T) {
-        self.filter.lend_sin_cos_two_alpha(alpha_rad, sin, cos);
+        debug_assert_eq!(
+            self.filter.alpha_rate_and_variance().map(|(a, _, _)| a),
+            Some(alpha_rad)
+        );
+        self.filter.lend_sin_cos_two_alpha_hat(sin, cos);
     }
 
     /// The end of a step: it commanded `c` for the coming period (the drive of the next
@@ -157,19 +173,24 @@ impl<T: Real> Estimation<T> {
     ) -> (Estimated<T>, Option<EventKind>) {
         let mut reel_rate_mps = None;
         if let Some((orbit_rate_radps, true_anomaly_rad, measured)) = sample {
-            self.orbit = Some(self.orbit_terms(orbit_rate_radps, true_anomaly_rad));
+            self.sense_orbit(orbit_rate_radps, true_anomaly_rad);
             reel_rate_mps = measured;
         }
-        let lost = if periods > MAX_CARRIED_PERIODS {
-            let had = self.filter.estimate().is_some();
-            self.filter.reset();
-            had
-        } else {
-            // The periods before the last (a gap in the calls), then the last one, with the
-            // encoder's rate (that of the period that just ended).
-            let gap_lost = periods > 1 && self.carry_gap(periods - 1);
-            let last_lost = periods > 0 && self.carry(periods - 1, reel_rate_mps);
-            gap_lost || last_lost
+        // The last period with the encoder's rate (that of the period that just ended), after
+        // the periods of a gap in the calls. One period, the common case, tested first.
+        let lost = match periods {
+            1 => self.carry(0, reel_rate_mps),
+            0 => false,
+            2..=MAX_CARRIED_PERIODS => {
+                let gap_lost = self.carry_gap(periods - 1);
+                let last_lost = self.carry(periods - 1, reel_rate_mps);
+                gap_lost || last_lost
+            }
+            _ => {
+                let had = self.filter.estimate().is_some();
+                self.filter.reset();
+                had
+            }
         };
         // The monitor checked α: |α| ≤ π.
         let m = self.filter.update_with_angle(alpha_rad);
@@ -185,17 +206,17 @@ impl<T: Real> Estimation<T> {
         } else {
             event
         };
-        if matches!(
+        // An α used now makes the estimate worth judging again.
+        let used = matches!(
             m,
             Measurement::Accepted(_) | Measurement::Initialised | Measurement::Reinitialised(_)
-        ) {
-            self.useless = false;
-        }
+        );
         let verdict = match (m, estimate) {
             (Measurement::Gated(_), _) => Estimated::Unusable(Sensor::AlphaGated),
             (_, Some((alpha_rad, alpha_rate_radps, alpha_var_rad2)))
-                if !self.useless && alpha_var_rad2 <= self.max_alpha_var_rad2 =>
+                if (used || !self.useless) && alpha_var_rad2 <= self.max_alpha_var_rad2 =>
             {
+                self.useless = false;
                 Estimated::Usable(alpha_rad, alpha_rate_radps)
             }
             _ => {
@@ -236,30 +257,33 @@ impl<T: Real> Estimation<T> {
         lost
     }
 
-    /// The orbit's terms at a sample: θ̈ and μ/R³ from θ on an eccentric orbit, 0 and θ̇² on a
-    /// circular one.
-    fn orbit_terms(&self, rate_radps: T, true_anomaly_rad: T) -> OrbitTerms<T> {
+    /// Keeps the orbit's terms at a sample: θ̈ and μ/R³ from θ on an eccentric orbit, θ̇² on a
+    /// circular one (whose θ̈ is the 0 it starts with).
+    // θ̈ = 0 not stored again every step: mission median/worst 858/880 → 855/878
+    // (scripts/bench-target).
+    fn sense_orbit(&mut self, rate_radps: T, true_anomaly_rad: T) {
         match &self.eccentric {
-            Some(o) => OrbitTerms {
-                rate_radps,
-                accel_radps2: o.true_anomaly_accel_radps2(true_anomaly_rad),
-                gravity_gradient_per_s2: o.gravity_gradient_per_s2(true_anomaly_rad),
-            },
-            None => OrbitTerms {
-                rate_radps,
-                accel_radps2: T::ZERO,
-                gravity_gradient_per_s2: rate_radps * rate_radps,
-            },
+            Some(o) => {
+                self.orbit = OrbitTerms {
+                    rate_radps,
+                    accel_radps2: o.true_anomaly_accel_radps2(true_anomaly_rad),
+                    gravity_gradient_per_s2: o.gravity_gradient_per_s2(true_anomaly_rad),
+                }
+            }
+            None => {
+                self.orbit.rate_radps = rate_radps;
+                self.orbit.gravity_gradient_per_s2 = rate_radps * rate_radps;
+            }
         }
     }
 
     /// The drive of the `k`-th period since the last step: the last step's command, its length
     /// advanced by k periods of it; the rate measured over the period when the encoder gave
     /// one (taken as the period's mean: the drive's rate at mid-period, so its start rate is
-    /// the mean less half the period's commanded change). `None` without a command or orbit
-    /// terms yet (then there is no estimate to carry either).
+    /// the mean less half the period's commanded change). `None` without a command yet
+    /// (the estimate is then dropped: nothing says how the reel moved).
     fn drive(&self, k: u32, reel_rate_mps: Option<T>) -> Option<Drive<T>> {
-        let (c, o) = (self.commanded?, self.orbit?);
+        let (c, o) = (self.commanded?, self.orbit);
         let h = self.filter.config().period_s;
         let rate_mps = match reel_rate_mps {
             Some(mean) => mean - T::from_f64(0.5) * c.accel_mps2 * h,
@@ -313,14 +337,18 @@ mod tests {
     #[test]
     fn the_drive_takes_the_orbit_terms_from_theta_on_an_eccentric_orbit_only() {
         let cfg = estimator::Config::<f64>::paper();
-        let circular = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), RATES).unwrap();
+        let mut circular = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), RATES).unwrap();
         let n = 1.06e-3;
-        let t = circular.orbit_terms(n, 2.0);
-        assert_eq!((t.accel_radps2, t.gravity_gradient_per_s2), (0.0, n * n));
+        circular.sense_orbit(n, 2.0);
+        let t = circular.orbit;
+        assert_eq!(t.rate_radps, n);
+        assert_eq!(t.accel_radps2.to_bits(), 0.0_f64.to_bits());
+        assert_eq!(t.gravity_gradient_per_s2, n * n);
         let orbit = Orbit::elliptic(7_078_000.0, 0.1);
-        let eccentric = Estimation::new(&cfg, &orbit, RATES).unwrap();
+        let mut eccentric = Estimation::new(&cfg, &orbit, RATES).unwrap();
         let theta = 2.0;
-        let t = eccentric.orbit_terms(n, theta);
+        eccentric.sense_orbit(n, theta);
+        let t = eccentric.orbit;
         assert_eq!(t.rate_radps, n);
         assert_eq!(t.accel_radps2, orbit.true_anomaly_accel_radps2(theta));
         assert_eq!(
@@ -335,7 +363,7 @@ mod tests {
         let cfg = estimator::Config::<f64>::paper();
         let mut e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), RATES).unwrap();
         assert_eq!(e.drive(0, None), None);
-        e.orbit = Some(e.orbit_terms(1.06e-3, 0.0));
+        e.sense_orbit(1.06e-3, 0.0);
         let c = Commanded {
             length_m: 100.0,
             rate_mps: 2.0,
