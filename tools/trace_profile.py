@@ -37,8 +37,8 @@ import tempfile
 # (category, pattern over the inlining chain, innermost first); the first match wins.
 CATEGORIES = [
     ("estimator: drive checks (stretch)", r"Estimator.*::stretch|estimator::refusal"),
-    ("estimator: covariance propagation (Φ P Φᵀ + Q, caps)", r"Sym3.*::(propagated|rounding_loaded|plus|capped)"),
-    ("estimator: Joseph update", r"Sym3.*::joseph"),
+    ("estimator: covariance propagation (Φ P Φᵀ + Q, caps)", r"Sym3.*::(propagated|rounding_loaded|plus|cap)"),
+    ("estimator: covariance update (P − K pᵀ, α row r K)", r"Sym3.*::posterior"),
     ("estimator: prediction (Ψ, Φ, the state)", r"Estimator.*::predict"),
     ("estimator: update (gate, gain, state)", r"Estimator.*::update"),
     ("estimator: the rest", r"estimator::"),
