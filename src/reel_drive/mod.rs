@@ -757,14 +757,16 @@ impl SpeedLoop {
     /// but the first is [`DriveFault::TensionOutOfRange`]. Each bound is compared once, and
     /// the infinities are told apart only beyond a bound (a reading in range takes the same
     /// two comparisons as before; an overload 9 instructions less than testing range, then
-    /// finiteness, then the side: the step's worst paths 206 → 199 with one fault, 236 → 231
+    /// finiteness, then the side: the step's worst paths 206 → 199 with one fault, 236 → 230
     /// with all of them, with [`Odometer`]'s speed from the total it has just written,
     /// `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
     fn tension(&mut self, reading: Option<f32>, faults: &mut DriveFaults) -> f32 {
         let (lo, hi) = (self.cfg.faults.min_tension_n, self.cfg.faults.max_tension_n);
         match reading {
             Some(t) if t > hi => {
-                if t < f32::INFINITY {
+                // (Finite: above `hi`, so not NaN, and not +∞; 1 instruction less than
+                // `t < ∞`.)
+                if t != f32::INFINITY {
                     self.tension_n = hi;
                 }
                 faults.insert(DriveFault::TensionOutOfRange);
