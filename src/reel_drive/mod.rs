@@ -413,7 +413,9 @@ pub struct SpeedLoop {
     last_tick: Option<u32>,
     stall_ticks: u32,
     saturated_ticks: u32,
-    brake: Brake,
+    /// The last step's output. Its `brake` is the brake's state, which the step, `trip` and
+    /// `clear_trip` change in place (a copy of it beside the output cost the step a load
+    /// and a store, `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
     out: DriveOutput,
 }
 
@@ -450,7 +452,6 @@ impl SpeedLoop {
             last_tick: None,
             stall_ticks: 0,
             saturated_ticks: 0,
-            brake: Brake::Engaged,
             out: DriveOutput::IDLE,
         })
     }
@@ -460,7 +461,8 @@ impl SpeedLoop {
         &self.cfg
     }
 
-    /// The last step's output.
+    /// The last step's output (with the brake's state after a [`trip`](Self::trip) or
+    /// [`clear_trip`](Self::clear_trip) since).
     pub fn output(&self) -> &DriveOutput {
         &self.out
     }
@@ -472,7 +474,7 @@ impl SpeedLoop {
 
     /// The brake's state.
     pub fn brake(&self) -> Brake {
-        self.brake
+        self.out.brake
     }
 
     /// The parts of the last step's torque ([`DriveOutput::torque_nm`] is their sum): with
@@ -535,9 +537,8 @@ impl SpeedLoop {
     /// Trips the drive for `fault` (motor off, brake on) — for faults found outside the step,
     /// such as a refused actuator write. A drive already tripped keeps its first fault.
     pub fn trip(&mut self, fault: DriveFault) {
-        if !matches!(self.brake, Brake::Tripped(_)) {
-            self.brake = Brake::Tripped(fault);
-            self.out.brake = self.brake;
+        if !matches!(self.out.brake, Brake::Tripped(_)) {
+            self.out.brake = Brake::Tripped(fault);
             self.out.duty = 0.0;
             self.integral_nm = 0.0;
         }
@@ -548,9 +549,9 @@ impl SpeedLoop {
     /// ([`Odometer::resync`]: whatever the drum did while tripped is not counted). Returns the
     /// fault that was cleared.
     pub fn clear_trip(&mut self) -> Option<DriveFault> {
-        match self.brake {
+        match self.out.brake {
             Brake::Tripped(f) => {
-                self.brake = Brake::Engaged;
+                self.out.brake = Brake::Engaged;
                 self.stall_ticks = 0;
                 self.saturated_ticks = 0;
                 self.odometer.resync();
@@ -603,11 +604,11 @@ impl SpeedLoop {
         }
         let tension_n = self.tension(input.tension_n, &mut faults);
 
-        self.brake = self.next_brake(tick, gap_ticks, speed_mps, counted.is_ok());
+        self.out.brake = self.next_brake(tick, gap_ticks, speed_mps, counted.is_ok());
 
         // The torque: PI + feed-forward with the brake free; while it lifts, the motor takes
         // over the tension's torque, nothing else; otherwise the motor is off.
-        let (ref_mps, ref_accel_mps2, torque_nm) = match self.brake {
+        let (ref_mps, ref_accel_mps2, torque_nm) = match self.out.brake {
             Brake::Released { rest_ticks } => {
                 let law = self.speed_law(tick, gap_ticks, speed_mps, tension_n);
                 if rest_ticks > 0 {
@@ -654,18 +655,17 @@ impl SpeedLoop {
             self.saturated_ticks = 0;
         }
 
-        self.out = DriveOutput {
-            tick,
-            ref_rate_mps: ref_mps,
-            ref_accel_mps2,
-            speed_mps,
-            tension_n,
-            torque_nm,
-            duty,
-            saturated,
-            brake: self.brake,
-            faults,
-        };
+        // (The brake is in place.)
+        let out = &mut self.out;
+        out.tick = tick;
+        out.ref_rate_mps = ref_mps;
+        out.ref_accel_mps2 = ref_accel_mps2;
+        out.speed_mps = speed_mps;
+        out.tension_n = tension_n;
+        out.torque_nm = torque_nm;
+        out.duty = duty;
+        out.saturated = saturated;
+        out.faults = faults;
         &self.out
     }
 
@@ -729,7 +729,7 @@ impl SpeedLoop {
             if self.stall_ticks >= f.stall_ticks {
                 // `trip` without its test of the brake (free here) and without its writes
                 // of the output, which the step writes next.
-                self.brake = Brake::Tripped(DriveFault::MotorStall);
+                self.out.brake = Brake::Tripped(DriveFault::MotorStall);
                 self.integral_nm = 0.0;
                 return true;
             }
@@ -789,7 +789,7 @@ impl SpeedLoop {
     fn next_brake(&mut self, tick: u32, gap_ticks: u32, speed_mps: f32, counted: bool) -> Brake {
         let hold = self.command.safe_hold;
         let target_moving = self.command_moving;
-        match self.brake {
+        match self.out.brake {
             Brake::Tripped(f) => Brake::Tripped(f),
             Brake::Engaged => {
                 if target_moving && !hold && counted {
@@ -982,6 +982,26 @@ mod tests {
             let in_range = reading.is_some_and(|t| (-5.0..=200.0).contains(&t));
             assert_eq!(faults.is_empty(), in_range, "{reading:?}");
         }
+    }
+
+    #[test]
+    fn the_output_shows_the_brake_after_a_trip_and_its_clearing() {
+        let mut s = SpeedLoop::new(DriveConfig::example()).unwrap();
+        s.trip(DriveFault::Actuator);
+        assert_eq!(s.output().brake, Brake::Tripped(DriveFault::Actuator));
+        assert_eq!(s.brake(), s.output().brake);
+        assert_eq!(s.clear_trip(), Some(DriveFault::Actuator));
+        assert_eq!(
+            (s.brake(), s.output().brake),
+            (Brake::Engaged, Brake::Engaged)
+        );
+        let out = *s.step(&DriveInput {
+            tick: 0,
+            encoder_count: Some(0),
+            tension_n: Some(20.0),
+        });
+        assert_eq!((out.brake, out.duty), (Brake::Engaged, 0.0));
+        assert!(out.faults.is_empty());
     }
 
     #[test]
