@@ -408,14 +408,14 @@ pub struct SpeedLoop {
     /// out with the command, so that the release's step has no division.
     ramp_from_rest: Ramp,
     integral_nm: f32,
-    /// The tension the feed-forward uses (the last good reading, clamped into range), N.
-    tension_n: f32,
     last_tick: Option<u32>,
     stall_ticks: u32,
     saturated_ticks: u32,
     /// The last step's output. Its `brake` is the brake's state, which the step, `trip` and
-    /// `clear_trip` change in place (a copy of it beside the output cost the step a load
-    /// and a store, `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
+    /// `clear_trip` change in place, and its `tension_n` the tension the feed-forward uses
+    /// (the last good reading, clamped into range), which `tension` keeps (a copy of each
+    /// beside the output cost the step a load and a store, then a store: worst 230 → 226 →
+    /// 225, `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
     out: DriveOutput,
 }
 
@@ -448,7 +448,6 @@ impl SpeedLoop {
             ramp: Ramp::REST,
             ramp_from_rest: Ramp::REST,
             integral_nm: 0.0,
-            tension_n: 0.0,
             last_tick: None,
             stall_ticks: 0,
             saturated_ticks: 0,
@@ -656,12 +655,12 @@ impl SpeedLoop {
         }
 
         // (The brake is in place.)
+        // (And so is the tension, by `tension`.)
         let out = &mut self.out;
         out.tick = tick;
         out.ref_rate_mps = ref_mps;
         out.ref_accel_mps2 = ref_accel_mps2;
         out.speed_mps = speed_mps;
-        out.tension_n = tension_n;
         out.torque_nm = torque_nm;
         out.duty = duty;
         out.saturated = saturated;
@@ -767,20 +766,20 @@ impl SpeedLoop {
                 // (Finite: above `hi`, so not NaN, and not +∞; 1 instruction less than
                 // `t < ∞`.)
                 if t != f32::INFINITY {
-                    self.tension_n = hi;
+                    self.out.tension_n = hi;
                 }
                 faults.insert(DriveFault::TensionOutOfRange);
             }
-            Some(t) if t >= lo => self.tension_n = t,
+            Some(t) if t >= lo => self.out.tension_n = t,
             Some(t) => {
                 if t > f32::NEG_INFINITY {
-                    self.tension_n = lo;
+                    self.out.tension_n = lo;
                 }
                 faults.insert(DriveFault::TensionOutOfRange);
             }
             None => faults.insert(DriveFault::TensionOutOfRange),
         }
-        self.tension_n
+        self.out.tension_n
     }
 
     /// The brake's next state (see [`Brake`]).
