@@ -408,7 +408,10 @@ pub struct SpeedLoop {
     /// out with the command, so that the release's step has no division.
     ramp_from_rest: Ramp,
     integral_nm: f32,
-    last_tick: Option<u32>,
+    /// A step has been taken, so the output's `tick` is the last step's tick (kept once,
+    /// there: an `Option` of it beside the output cost the step a store, 2 instructions on the
+    /// mission's worst path, `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
+    stepped: bool,
     stall_ticks: u32,
     saturated_ticks: u32,
     /// The last step's output. Its `brake` is the brake's state, which the step, `trip` and
@@ -448,7 +451,7 @@ impl SpeedLoop {
             ramp: Ramp::REST,
             ramp_from_rest: Ramp::REST,
             integral_nm: 0.0,
-            last_tick: None,
+            stepped: false,
             stall_ticks: 0,
             saturated_ticks: 0,
             out: DriveOutput::IDLE,
@@ -564,16 +567,18 @@ impl SpeedLoop {
     /// brake in the output are what the hardware is to be set to.
     pub fn step(&mut self, input: &DriveInput) -> &DriveOutput {
         let tick = input.tick;
-        // Integer time: the tick must advance (wrapping, by less than half the range).
-        let gap_ticks = match self.last_tick {
-            None => 1,
-            Some(last) => tick.wrapping_sub(last),
+        // Integer time: the tick must advance (wrapping, by less than half the range); the
+        // first step's gap is one tick.
+        let gap_ticks = if self.stepped {
+            tick.wrapping_sub(self.out.tick)
+        } else {
+            self.stepped = true;
+            1
         };
         // (0 and anything beyond half the range in one comparison: 0 − 1 wraps to the top.)
         if gap_ticks.wrapping_sub(1) >= i32::MAX as u32 {
             return self.reject_tick();
         }
-        self.last_tick = Some(tick);
         let mut faults = self.command_faults;
 
         // Odometry: a reading the odometer cannot take is a fault; too long without one trips.
