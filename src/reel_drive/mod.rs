@@ -659,8 +659,7 @@ impl SpeedLoop {
             self.saturated_ticks = 0;
         }
 
-        // (The brake is in place.)
-        // (And so is the tension, by `tension`.)
+        // (The brake and the tension are in place.)
         let out = &mut self.out;
         out.tick = tick;
         out.ref_rate_mps = ref_mps;
@@ -731,8 +730,8 @@ impl SpeedLoop {
             // `Odometer::update_after` for the figure.)
             self.stall_ticks = self.stall_ticks.wrapping_add(gap_ticks);
             if self.stall_ticks >= f.stall_ticks {
-                // `trip` without its test of the brake (free here) and without its writes
-                // of the output, which the step writes next.
+                // `trip` without its test of the brake (free here) and without its write of
+                // the duty, which the step writes next.
                 self.out.brake = Brake::Tripped(DriveFault::MotorStall);
                 self.integral_nm = 0.0;
                 return true;
