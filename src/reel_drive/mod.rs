@@ -408,12 +408,17 @@ pub struct SpeedLoop {
     /// out with the command, so that the release's step has no division.
     ramp_from_rest: Ramp,
     integral_nm: f32,
-    /// The tension the feed-forward uses (the last good reading, clamped into range), N.
-    tension_n: f32,
-    last_tick: Option<u32>,
+    /// A step has been taken, so the output's `tick` is the last step's tick (kept once,
+    /// there: an `Option` of it beside the output cost the step a store, 2 instructions on the
+    /// mission's worst path, `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
+    stepped: bool,
     stall_ticks: u32,
     saturated_ticks: u32,
-    brake: Brake,
+    /// The last step's output. Its `brake` is the brake's state, which the step, `trip` and
+    /// `clear_trip` change in place, and its `tension_n` the tension the feed-forward uses
+    /// (the last good reading, clamped into range), which `tension` keeps (a copy of each
+    /// beside the output cost the step a load and a store, then a store: worst 230 → 226 →
+    /// 225, `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
     out: DriveOutput,
 }
 
@@ -446,11 +451,9 @@ impl SpeedLoop {
             ramp: Ramp::REST,
             ramp_from_rest: Ramp::REST,
             integral_nm: 0.0,
-            tension_n: 0.0,
-            last_tick: None,
+            stepped: false,
             stall_ticks: 0,
             saturated_ticks: 0,
-            brake: Brake::Engaged,
             out: DriveOutput::IDLE,
         })
     }
@@ -460,7 +463,8 @@ impl SpeedLoop {
         &self.cfg
     }
 
-    /// The last step's output.
+    /// The last step's output (with the brake's state after a [`trip`](Self::trip) or
+    /// [`clear_trip`](Self::clear_trip) since).
     pub fn output(&self) -> &DriveOutput {
         &self.out
     }
@@ -472,7 +476,7 @@ impl SpeedLoop {
 
     /// The brake's state.
     pub fn brake(&self) -> Brake {
-        self.brake
+        self.out.brake
     }
 
     /// The parts of the last step's torque ([`DriveOutput::torque_nm`] is their sum): with
@@ -535,9 +539,8 @@ impl SpeedLoop {
     /// Trips the drive for `fault` (motor off, brake on) — for faults found outside the step,
     /// such as a refused actuator write. A drive already tripped keeps its first fault.
     pub fn trip(&mut self, fault: DriveFault) {
-        if !matches!(self.brake, Brake::Tripped(_)) {
-            self.brake = Brake::Tripped(fault);
-            self.out.brake = self.brake;
+        if !matches!(self.out.brake, Brake::Tripped(_)) {
+            self.out.brake = Brake::Tripped(fault);
             self.out.duty = 0.0;
             self.integral_nm = 0.0;
         }
@@ -548,9 +551,9 @@ impl SpeedLoop {
     /// ([`Odometer::resync`]: whatever the drum did while tripped is not counted). Returns the
     /// fault that was cleared.
     pub fn clear_trip(&mut self) -> Option<DriveFault> {
-        match self.brake {
+        match self.out.brake {
             Brake::Tripped(f) => {
-                self.brake = Brake::Engaged;
+                self.out.brake = Brake::Engaged;
                 self.stall_ticks = 0;
                 self.saturated_ticks = 0;
                 self.odometer.resync();
@@ -564,16 +567,18 @@ impl SpeedLoop {
     /// brake in the output are what the hardware is to be set to.
     pub fn step(&mut self, input: &DriveInput) -> &DriveOutput {
         let tick = input.tick;
-        // Integer time: the tick must advance (wrapping, by less than half the range).
-        let gap_ticks = match self.last_tick {
-            None => 1,
-            Some(last) => tick.wrapping_sub(last),
+        // Integer time: the tick must advance (wrapping, by less than half the range); the
+        // first step's gap is one tick.
+        let gap_ticks = if self.stepped {
+            tick.wrapping_sub(self.out.tick)
+        } else {
+            self.stepped = true;
+            1
         };
         // (0 and anything beyond half the range in one comparison: 0 − 1 wraps to the top.)
         if gap_ticks.wrapping_sub(1) >= i32::MAX as u32 {
             return self.reject_tick();
         }
-        self.last_tick = Some(tick);
         let mut faults = self.command_faults;
 
         // Odometry: a reading the odometer cannot take is a fault; too long without one trips.
@@ -585,7 +590,7 @@ impl SpeedLoop {
         } else {
             None
         };
-        let counted = self.odometer.update_after(tick, gap_ticks, reading);
+        let (counted, speed_mps) = self.odometer.update_after(tick, gap_ticks, reading);
         if let Err(f) = counted {
             let fault = match f {
                 CountFault::Jump => DriveFault::EncoderJump,
@@ -601,14 +606,13 @@ impl SpeedLoop {
                 self.trip(fault);
             }
         }
-        let speed_mps = self.odometer.speed_mps();
         let tension_n = self.tension(input.tension_n, &mut faults);
 
-        self.brake = self.next_brake(tick, gap_ticks, speed_mps, counted.is_ok());
+        self.advance_brake(tick, gap_ticks, speed_mps, counted.is_ok());
 
         // The torque: PI + feed-forward with the brake free; while it lifts, the motor takes
         // over the tension's torque, nothing else; otherwise the motor is off.
-        let (ref_mps, ref_accel_mps2, torque_nm) = match self.brake {
+        let (ref_mps, ref_accel_mps2, torque_nm) = match self.out.brake {
             Brake::Released { rest_ticks } => {
                 let law = self.speed_law(tick, gap_ticks, speed_mps, tension_n);
                 if rest_ticks > 0 {
@@ -655,18 +659,16 @@ impl SpeedLoop {
             self.saturated_ticks = 0;
         }
 
-        self.out = DriveOutput {
-            tick,
-            ref_rate_mps: ref_mps,
-            ref_accel_mps2,
-            speed_mps,
-            tension_n,
-            torque_nm,
-            duty,
-            saturated,
-            brake: self.brake,
-            faults,
-        };
+        // (The brake and the tension are in place.)
+        let out = &mut self.out;
+        out.tick = tick;
+        out.ref_rate_mps = ref_mps;
+        out.ref_accel_mps2 = ref_accel_mps2;
+        out.speed_mps = speed_mps;
+        out.torque_nm = torque_nm;
+        out.duty = duty;
+        out.saturated = saturated;
+        out.faults = faults;
         &self.out
     }
 
@@ -728,9 +730,9 @@ impl SpeedLoop {
             // `Odometer::update_after` for the figure.)
             self.stall_ticks = self.stall_ticks.wrapping_add(gap_ticks);
             if self.stall_ticks >= f.stall_ticks {
-                // `trip` without its test of the brake (free here) and without its writes
-                // of the output, which the step writes next.
-                self.brake = Brake::Tripped(DriveFault::MotorStall);
+                // `trip` without its test of the brake (free here) and without its write of
+                // the duty, which the step writes next.
+                self.out.brake = Brake::Tripped(DriveFault::MotorStall);
                 self.integral_nm = 0.0;
                 return true;
             }
@@ -755,35 +757,52 @@ impl SpeedLoop {
 
     /// The tension the feed-forward uses: a reading inside [min, max] as is; a finite one
     /// outside, clamped into it; a missing or non-finite one, the last good value. Anything
-    /// but the first is [`DriveFault::TensionOutOfRange`].
+    /// but the first is [`DriveFault::TensionOutOfRange`]. Each bound is compared once, and
+    /// the infinities are told apart only beyond a bound (a reading in range takes the same
+    /// two comparisons as before; an overload 9 instructions less than testing range, then
+    /// finiteness, then the side: the step's worst paths 206 → 199 with one fault, 236 → 230
+    /// with all of them, with [`Odometer`]'s speed from the total it has just written,
+    /// `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
     fn tension(&mut self, reading: Option<f32>, faults: &mut DriveFaults) -> f32 {
         let (lo, hi) = (self.cfg.faults.min_tension_n, self.cfg.faults.max_tension_n);
         match reading {
-            Some(t) if (lo..=hi).contains(&t) => self.tension_n = t,
-            Some(t) if t.is_finite() => {
-                self.tension_n = if t < lo { lo } else { hi };
+            Some(t) if t > hi => {
+                // (Finite: above `hi`, so not NaN, and not +∞; 1 instruction less than
+                // `t < ∞`.)
+                if t != f32::INFINITY {
+                    self.out.tension_n = hi;
+                }
                 faults.insert(DriveFault::TensionOutOfRange);
             }
-            _ => faults.insert(DriveFault::TensionOutOfRange),
+            Some(t) if t >= lo => self.out.tension_n = t,
+            Some(t) => {
+                if t > f32::NEG_INFINITY {
+                    self.out.tension_n = lo;
+                }
+                faults.insert(DriveFault::TensionOutOfRange);
+            }
+            None => faults.insert(DriveFault::TensionOutOfRange),
         }
-        self.tension_n
+        self.out.tension_n
     }
 
-    /// The brake's next state (see [`Brake`]).
+    /// Moves the brake (the output's, see [`Brake`]) to its next state, in place: a state
+    /// that stays is not written again (the rest count alone; 2 instructions less on the
+    /// mission's worst path, 189 → 187, `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
     /// Entering `Released` starts the ramp from rest at `tick` (the drum was held until now).
-    /// At rest means the command, the last reference and the measured speed all ~0.
-    fn next_brake(&mut self, tick: u32, gap_ticks: u32, speed_mps: f32, counted: bool) -> Brake {
+    /// At rest means the command and the measured speed ~0.
+    fn advance_brake(&mut self, tick: u32, gap_ticks: u32, speed_mps: f32, counted: bool) {
         let hold = self.command.safe_hold;
         let target_moving = self.command_moving;
-        match self.brake {
-            Brake::Tripped(f) => Brake::Tripped(f),
+        let next = match self.out.brake {
+            Brake::Tripped(_) => return,
             Brake::Engaged => {
                 if target_moving && !hold && counted {
                     Brake::Releasing {
                         ticks_left: self.cfg.brake.release_ticks,
                     }
                 } else {
-                    Brake::Engaged
+                    return;
                 }
             }
             Brake::Releasing { ticks_left } => {
@@ -801,24 +820,25 @@ impl SpeedLoop {
                     }
                 }
             }
-            Brake::Released { rest_ticks } => {
+            Brake::Released { ref mut rest_ticks } => {
                 // At rest: the command is rest and the drum is at rest (its reference, which
                 // it follows, is on its way there; waiting for it as well made the step's
                 // worst path 5 instructions longer, `examples/bench_speed_loop.rs`).
                 let at_rest = !target_moving && speed_mps.abs() <= self.cfg.brake.rest_speed_mps;
                 if !at_rest {
-                    Brake::Released { rest_ticks: 0 }
+                    *rest_ticks = 0;
+                    return;
+                }
+                // (Cannot wrap: below `engage_ticks` ≤ 2³¹ − 1, plus a gap below 2³¹.)
+                *rest_ticks = rest_ticks.wrapping_add(gap_ticks);
+                if *rest_ticks >= self.cfg.brake.engage_ticks {
+                    Brake::Engaged
                 } else {
-                    // (Cannot wrap: below `engage_ticks` ≤ 2³¹ − 1, plus a gap below 2³¹.)
-                    let rest_ticks = rest_ticks.wrapping_add(gap_ticks);
-                    if rest_ticks >= self.cfg.brake.engage_ticks {
-                        Brake::Engaged
-                    } else {
-                        Brake::Released { rest_ticks }
-                    }
+                    return;
                 }
             }
-        }
+        };
+        self.out.brake = next;
     }
 
     /// The ramp from `start_mps` at `tick` toward the command: its slope is the command's
@@ -944,6 +964,50 @@ mod tests {
         .unwrap();
         let (v, a) = s.reference_at(1500);
         assert!((v - 0.75).abs() < 1e-6 && a == -0.5, "{v} {a}");
+    }
+
+    #[test]
+    fn a_tension_beyond_a_bound_is_clamped_and_an_infinite_one_not_used() {
+        let mut s = SpeedLoop::new(DriveConfig::example()).unwrap();
+        let mut faults = DriveFaults::NONE;
+        assert_eq!(s.tension(Some(20.0), &mut faults), 20.0);
+        assert!(faults.is_empty());
+        for (reading, used) in [
+            (Some(200.0), 200.0),
+            (Some(-5.0), -5.0),
+            (Some(f32::INFINITY), -5.0),
+            (Some(f32::NEG_INFINITY), -5.0),
+            (Some(f32::NAN), -5.0),
+            (Some(f32::MAX), 200.0),
+            (Some(f32::NEG_INFINITY), 200.0),
+            (Some(f32::MIN), -5.0),
+            (None, -5.0),
+        ] {
+            let mut faults = DriveFaults::NONE;
+            assert_eq!(s.tension(reading, &mut faults), used, "{reading:?}");
+            let in_range = reading.is_some_and(|t| (-5.0..=200.0).contains(&t));
+            assert_eq!(faults.is_empty(), in_range, "{reading:?}");
+        }
+    }
+
+    #[test]
+    fn the_output_shows_the_brake_after_a_trip_and_its_clearing() {
+        let mut s = SpeedLoop::new(DriveConfig::example()).unwrap();
+        s.trip(DriveFault::Actuator);
+        assert_eq!(s.output().brake, Brake::Tripped(DriveFault::Actuator));
+        assert_eq!(s.brake(), s.output().brake);
+        assert_eq!(s.clear_trip(), Some(DriveFault::Actuator));
+        assert_eq!(
+            (s.brake(), s.output().brake),
+            (Brake::Engaged, Brake::Engaged)
+        );
+        let out = *s.step(&DriveInput {
+            tick: 0,
+            encoder_count: Some(0),
+            tension_n: Some(20.0),
+        });
+        assert_eq!((out.brake, out.duty), (Brake::Engaged, 0.0));
+        assert!(out.faults.is_empty());
     }
 
     #[test]
