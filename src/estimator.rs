@@ -1266,6 +1266,14 @@ mod tests {
         assert!(close(p.wd, x[1] * x[2]), "{} vs {}", p.wd, x[1] * x[2]);
     }
 
+    /// The gain K = P e₁ / (P_αα + r) of an α sample of variance `r`, as `Estimator::update`
+    /// works it out, and the posterior covariance.
+    fn gain_and_posterior<T: Real>(p: &Sym3<T>, r: T) -> ([T; 3], Sym3<T>) {
+        let inv = T::ONE / (p.aa + r);
+        let k = [p.aa * inv, p.aw * inv, p.ad * inv];
+        (k, p.posterior(&k, r))
+    }
+
     #[test]
     fn the_update_keeps_the_covariance_symmetric_positive() {
         let p = Sym3 {
@@ -1277,9 +1285,7 @@ mod tests {
             dd: 1e-22,
         };
         let r = 1e-8_f64;
-        let inv = 1.0 / (p.aa + r);
-        let k = [p.aa * inv, p.aw * inv, p.ad * inv];
-        let j = p.posterior(&k, r);
+        let (k, j) = gain_and_posterior(&p, r);
         // Against P − K S Kᵀ, the same in exact arithmetic.
         let s = p.aa + r;
         let short = [
@@ -1309,9 +1315,7 @@ mod tests {
             dd: 1e-12,
         };
         let r = 1e-8_f32;
-        let inv = 1.0 / (p.aa + r);
-        let k = [p.aa * inv, p.aw * inv, p.ad * inv];
-        let j = p.posterior(&k, r);
+        let (_, j) = gain_and_posterior(&p, r);
         let s = f64::from(p.aa) + f64::from(r);
         let exact = |p_i: f32| f64::from(r) * f64::from(p_i) / s;
         for (got, p_i) in [(j.aa, p.aa), (j.aw, p.aw), (j.ad, p.ad)] {
@@ -1343,9 +1347,7 @@ mod tests {
             dd: 1e-22,
         };
         let r = 1e-8_f64;
-        let inv = 1.0 / (p.aa + r);
-        let k = [p.aa * inv, p.aw * inv, p.ad * inv];
-        let j = p.posterior(&k, r);
+        let (k, j) = gain_and_posterior(&p, r);
         let ww = p.ww - p.aw * k[1];
         assert!(ww < 0.0);
         assert_eq!(j.ww, -ww);
