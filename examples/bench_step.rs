@@ -34,12 +34,12 @@
 //! On a step where the law ran (health `Nominal`), the public pieces the controller calls are
 //! timed separately, with the step's own arguments: the reference schedule (`PreparedBand::eval`
 //! or the stage-2 `PreparedBand::eval_slewed`), the implicit law (`law::solve`) and its
-//! acceleration (`law::acceleration`), the blend weight and its complement
-//! (`law::Blend::from_log2`, once a step), the mass model (`MassModel::mu3_and_slope`), the
+//! acceleration (`law::acceleration`), the mass model (`MassModel::mu3_and_slope`), the
 //! equilibrium-existence margin
 //! (`ExistenceMonitor::whole_orbit_margin`) and the envelope (`Envelope::limit`). What is left of the
-//! step is the sensor validation (the monitor's checks), the estimator, the sequencer and health state machine,
-//! dead reckoning and filling in the output.
+//! step is the sensor validation (the monitor's checks), the estimator, the sequencer (with the
+//! Eq. 29 blend carried one period) and health state machine, dead reckoning and filling in the
+//! output.
 //!
 //! Needs the `firmware` feature and the bare-metal target (`required-features` in Cargo.toml).
 #![no_std]
@@ -88,8 +88,6 @@ mod bench {
         LawSolve,
         /// `law::acceleration`: Eq. 30.
         LawAccel,
-        /// The Eq. 29 blend weight e^{−cτ} and 1 − e^{−cτ}: `law::Blend::from_log2`, once per step.
-        BlendExp,
         /// μ3 and dμ3/dl: `MassModel::mu3_and_slope` (one comparison for a massless tether).
         MassModel,
         /// Eq. 13 existence margin: `ExistenceMonitor::whole_orbit_margin`.
@@ -98,11 +96,10 @@ mod bench {
         Envelope,
     }
 
-    const PARTS: [Part; 7] = [
+    const PARTS: [Part; 6] = [
         Part::Schedule,
         Part::LawSolve,
         Part::LawAccel,
-        Part::BlendExp,
         Part::MassModel,
         Part::Existence,
         Part::Envelope,
@@ -226,10 +223,6 @@ mod bench {
             Ok(s) => m.pure((law_in, *s), |(i, s)| law::acceleration(i, s)),
             Err(_) => 0,
         };
-        // The blend's argument log₂E = −cτ·log₂e ≤ −0, recovered from the reported weight (−0
-        // at a restart, as in the controller: (−cΔt·log₂e)·0).
-        let exponent = -libm::fabsf(libm::log2f(out.blend_weight.max(f32::MIN_POSITIVE)));
-        let blend = m.pure(exponent, |&e| Blend::from_log2(e));
         let mass = m.pure(l, |&l| masses.mu3_and_slope(l));
         let mu3 = law_in.mu3;
         let rate = out.rate_cmd_mps;
@@ -241,7 +234,7 @@ mod bench {
         let envelope = m.pure((requested, previous_rate_mps, l), |&(y, p, l)| {
             env.limit(y, p, l, cfg.period_s)
         });
-        [schedule, solve, accel, blend, mass, exist, envelope]
+        [schedule, solve, accel, mass, exist, envelope]
     }
 
     /// Flies a fresh controller in the flight configuration (`Config::flight`: the paper's

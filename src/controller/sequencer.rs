@@ -74,8 +74,48 @@ struct BlendStart<T> {
     initial_rate_mps: T,
     /// c of the current stage, 1/s.
     decay_rate_per_s: T,
+    /// The stage's constants per period.
+    per_tick: BlendPerTick<T>,
+    /// The blend at the last tick it was asked for, and that tick.
+    last: (u32, Blend<T>),
+    /// What E at that tick lacks of its value carried one period at a time: the roundings
+    /// of the carried E, kept apart (compensated summation: Kahan, Higham §4.3).
+    weight_low: T,
+}
+
+/// What one period does to a stage's Eq. 29 blend, worked out in f64 and rounded once.
+#[derive(Clone, Copy, Debug)]
+struct BlendPerTick<T> {
     /// −cΔt·log₂e: E = e^{−cΔt·k} = 2^{−cΔt·log₂e·k} k ticks after the start.
-    log2_weight_per_tick: T,
+    log2_weight: T,
+    /// 1 − e^{−cΔt}: the share of E that one period moves to 1 − E.
+    decayed_share: T,
+}
+
+impl<T: Real> BlendPerTick<T> {
+    /// The constants of the decay rate `decay_rate_per_s` (c) at the period `period_s` (Δt).
+    fn new(decay_rate_per_s: T, period_s: T) -> Self {
+        let c_dt = decay_rate_per_s.to_f64() * period_s.to_f64();
+        Self {
+            log2_weight: T::from_f64(-c_dt * core::f64::consts::LOG2_E),
+            decayed_share: T::from_f64(-libm::expm1(-c_dt)),
+        }
+    }
+}
+
+impl<T: Real> BlendStart<T> {
+    /// The blend of a stage with `per_tick`, (re)starting at `tick` from `initial_rate_mps`:
+    /// E = 1.
+    fn new(tick: u32, initial_rate_mps: T, decay_rate_per_s: T, per_tick: BlendPerTick<T>) -> Self {
+        Self {
+            tick,
+            initial_rate_mps,
+            decay_rate_per_s,
+            per_tick,
+            last: (tick, Blend::from_weight(T::ONE)),
+            weight_low: T::ZERO,
+        }
+    }
 }
 
 /// The sequencer's state and what it needs of the configuration.
@@ -96,8 +136,8 @@ pub(super) struct Sequencer<T> {
     librating: Option<LibratingReference<T>>,
     /// c of the stage-1 and stage-2 blends, 1/s.
     decay_rate_per_s: [T; 2],
-    /// −cΔt·log₂e of the stage-1 and stage-2 blends.
-    log2_weight_per_tick: [T; 2],
+    /// What a period does to the stage-1 and stage-2 blends.
+    blend_per_tick: [BlendPerTick<T>; 2],
     /// Deploy becomes Keep1 at this length: the stage-1 keep length less the capture, m.
     keep1_entry_m: T,
     /// Retrieve becomes Keep2 at this length: the stage-2 keep length plus the capture, m.
@@ -116,11 +156,9 @@ pub(super) struct Sequencer<T> {
 impl<T: Real> Sequencer<T> {
     /// The sequencer before the first step: stage 1, Deploy, the blend from l̇0.
     pub(super) fn new(cfg: &Config<T>) -> Self {
-        // −cΔt·log₂e, in f64 and rounded once.
         let dt = cfg.period_s.to_f64();
-        let log2_weight = |c: T| T::from_f64(-c.to_f64() * dt * core::f64::consts::LOG2_E);
         let decay_rate_per_s = [cfg.stage1.decay_rate_per_s, cfg.stage2.decay_rate_per_s];
-        let log2_weight_per_tick = decay_rate_per_s.map(log2_weight);
+        let blend_per_tick = decay_rate_per_s.map(|c| BlendPerTick::new(c, cfg.period_s));
         // The slowest time constant of each stage's loop: 2/k1 (Eq. 28's envelope, e^{−k1 t/2})
         // and 1/c (Eq. 29; none when c = 0), in periods.
         let envelope_s = 2.0 / cfg.gains.k1_per_s.to_f64();
@@ -138,17 +176,17 @@ impl<T: Real> Sequencer<T> {
                 Some(tick) => Stage2Start::At(tick),
                 None => Stage2Start::OnRequest,
             },
-            blend: BlendStart {
-                tick: 0,
-                initial_rate_mps: cfg.initial_rate_mps,
-                decay_rate_per_s: decay_rate_per_s[0],
-                log2_weight_per_tick: log2_weight_per_tick[0],
-            },
+            blend: BlendStart::new(
+                0,
+                cfg.initial_rate_mps,
+                decay_rate_per_s[0],
+                blend_per_tick[0],
+            ),
             stage1_band: cfg.stage1.schedule.prepare(),
             stage2_band: cfg.stage2.schedule.prepare(),
             librating: LibratingReference::new(&cfg.orbit),
             decay_rate_per_s,
-            log2_weight_per_tick,
+            blend_per_tick,
             keep1_entry_m: cfg.stage1.schedule.high_length_m - cfg.keep_capture_m,
             keep2_entry_m: cfg.stage2.schedule.low_length_m + cfg.keep_capture_m,
             slew_rate_radps: cfg.stage2.slew_rate_radps,
@@ -206,25 +244,55 @@ impl<T: Real> Sequencer<T> {
     /// Restarts the current stage's Eq. 29 blend at `tick` from `rate_mps`.
     pub(super) fn restart_blend(&mut self, tick: u32, rate_mps: T, flags: &mut Flags) {
         let stage = self.stage();
-        self.blend = BlendStart {
+        self.blend = BlendStart::new(
             tick,
-            initial_rate_mps: rate_mps,
-            decay_rate_per_s: self.decay_rate_per_s[stage],
-            log2_weight_per_tick: self.log2_weight_per_tick[stage],
-        };
+            rate_mps,
+            self.decay_rate_per_s[stage],
+            self.blend_per_tick[stage],
+        );
         self.approach = None;
         flags.set(Flags::BLEND_RESTART);
     }
 
     /// E = e^{−cτ} and 1 − E at `tick`, τ = k·Δt the time since the blend (re)started k ticks
-    /// before (Eq. 29), as 2^{k·(−cΔt·log₂e)}. `tick` is an accepted tick: at or after the
-    /// start, modulo 2³² (see `clock`).
-    // Inlined into both callers (the step and the safe action): with `reference`, 37
-    // instructions less on the mission's worst step (scripts/bench-target: 580 → 543).
+    /// before (Eq. 29), each to its own relative precision (docs/equations.md §5.2). `tick` is
+    /// an accepted tick: at or after the start, modulo 2³² (see `clock`), and at or after the
+    /// last one asked for.
+    ///
+    /// One period after the last tick asked for (each step of a mission without gaps), the
+    /// period's decay takes the share q = 1 − e^{−cΔt} of E away: E′ = E − qE, with the
+    /// subtraction's rounding kept apart and paid back the next period (compensated
+    /// summation), so E stays within a few roundings of e^{−cτ} however many periods it is
+    /// carried, and 1 − E′ = (1 − E′_hi) − E′_lo keeps its own precision (the first
+    /// difference is exact for E′ ≥ ½). After a gap in the calls E is worked out afresh as
+    /// 2^{k·(−cΔt·log₂e)}.
+    // One period as a product and five sums, where the exponential took 35 instructions a step
+    // (scripts/bench-target, mission median/worst 833/855 → 805/828).
     #[inline(always)]
-    pub(super) fn blend(&self, tick: u32) -> Blend<T> {
-        let k = T::from_u32(tick.wrapping_sub(self.blend.tick));
-        Blend::from_log2(self.blend.log2_weight_per_tick * k)
+    pub(super) fn blend(&mut self, tick: u32) -> Blend<T> {
+        let b = &mut self.blend;
+        let (last_tick, last) = b.last;
+        let now = match tick.wrapping_sub(last_tick) {
+            0 => last,
+            1 => {
+                // E_lo·q is below the roundings of E itself: left out.
+                let taken = last.weight * b.per_tick.decayed_share - b.weight_low;
+                let weight = last.weight - taken;
+                // Exact (Fast2Sum: E ≥ taken): what the subtraction rounded away.
+                b.weight_low = (last.weight - weight) - taken;
+                Blend {
+                    weight,
+                    complement: (T::ONE - weight) - b.weight_low,
+                }
+            }
+            _ => {
+                let k = T::from_u32(tick.wrapping_sub(b.tick));
+                b.weight_low = T::ZERO;
+                Blend::from_log2(b.per_tick.log2_weight * k)
+            }
+        };
+        b.last = (tick, now);
+        now
     }
 
     /// l̇0 of the current blend, m/s.
@@ -336,5 +404,80 @@ impl<T: Real> Sequencer<T> {
     /// The current phase was found stalled and has not progressed since.
     pub(super) fn stalled(&self) -> bool {
         self.approach.is_some_and(|a| a.stalled)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// |a − b| in units of the f32 spacing at b.
+    fn ulps(a: f32, b: f64) -> f64 {
+        let spacing = f64::from(f32::from_bits((b as f32).abs().to_bits() + 1) - (b as f32).abs());
+        (f64::from(a) - b).abs() / spacing
+    }
+
+    #[test]
+    fn the_blend_one_period_at_a_time_is_the_exponential() {
+        // Both stages' decay rates (1e-3 and 5e-4 1/s), carried over 100 000 periods (E down
+        // to 4e-44 and 2e-22) from a start at a tick near the wrap of the counter.
+        let cfg = Config::<f32>::paper();
+        let rates = [cfg.stage1.decay_rate_per_s, cfg.stage2.decay_rate_per_s];
+        for (stage, c) in rates.map(f64::from).into_iter().enumerate() {
+            let mut s = Sequencer::new(&cfg);
+            let start = u32::MAX - 10;
+            let mut flags = Flags::default();
+            s.phase = [Phase::Deploy, Phase::Retrieve][stage];
+            s.restart_blend(start, 0.0, &mut flags);
+            let (mut worst_weight, mut worst_complement) = (0.0_f64, 0.0_f64);
+            for k in 0..100_000_u32 {
+                let b = s.blend(start.wrapping_add(k));
+                let tau_s = f64::from(k) * f64::from(cfg.period_s);
+                let weight = (-c * tau_s).exp();
+                // The per-period constant's rounding (relative 2⁻²⁴ of q) adds up to cτ·2⁻²⁴
+                // of E, as the exponent's does in 2^{k·(−cΔt·log₂e)}: measured per cτ beyond 1.
+                if weight > 1e-30 {
+                    let per = (c * tau_s).max(1.0);
+                    worst_weight = worst_weight.max(ulps(b.weight, weight) / per);
+                }
+                worst_complement = worst_complement.max(ulps(b.complement, -(-c * tau_s).exp_m1()));
+            }
+            // Carried, E and 1 − E stay within 2 ulps each (E: per cτ beyond 1; measured
+            // 1.23 and 1.26 for stage 1).
+            // Uncompensated (E − qE and 1 − E + qE rounded each period): 6.4 and 302.
+            assert!(
+                worst_weight <= 2.0,
+                "stage {stage}: E off by {worst_weight} ulps"
+            );
+            assert!(
+                worst_complement <= 2.0,
+                "stage {stage}: 1 − E off by {worst_complement} ulps"
+            );
+        }
+    }
+
+    #[test]
+    fn after_a_gap_the_blend_is_worked_out_afresh_from_its_start() {
+        let cfg = Config::<f32>::paper();
+        let mut s = Sequencer::new(&cfg);
+        let mut flags = Flags::default();
+        s.restart_blend(100, 0.0, &mut flags);
+        for tick in 100..=600 {
+            s.blend(tick);
+        }
+        // 600 → 900 (a gap of 300 periods), then the same tick again.
+        let after_gap = s.blend(900);
+        let afresh = Blend::<f32>::from_log2(s.blend.per_tick.log2_weight * 800.0);
+        assert_eq!(after_gap.weight, afresh.weight);
+        assert_eq!(after_gap.complement, afresh.complement);
+        assert_eq!(s.blend(900).weight, afresh.weight);
+        // And the next period carries on from it.
+        let next = s.blend(901);
+        let exact = (-f64::from(cfg.stage1.decay_rate_per_s) * 801.0).exp();
+        assert!(ulps(next.weight, exact) <= 4.0);
+        // A restart is E = 1 at its tick.
+        s.restart_blend(901, 0.0, &mut flags);
+        let restarted = s.blend(901);
+        assert_eq!((restarted.weight, restarted.complement), (1.0, 0.0));
     }
 }
