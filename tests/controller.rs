@@ -368,6 +368,38 @@ fn early_deployment_is_flagged_outside_the_equilibrium_region() {
 }
 
 #[test]
+fn a_new_phase_is_flagged_and_recorded_at_its_step_only() {
+    use tss_reel::controller::{EventKind, Phase};
+    let mut ctl = paper();
+    let first = *ctl.step(&sample(0, 20_000.0));
+    assert!(!first.flags.contains(Flags::PHASE_CHANGED));
+    assert_eq!(
+        ctl.pop_event().map(|e| e.kind),
+        Some(EventKind::BlendRestart)
+    );
+    ctl.start_stage2();
+    let slew = *ctl.step(&sample(1, 20_000.0));
+    assert_eq!(slew.phase, Phase::Slew);
+    assert!(slew
+        .flags
+        .contains(Flags::PHASE_CHANGED | Flags::BLEND_RESTART));
+    let kinds: Vec<_> = std::iter::from_fn(|| ctl.pop_event())
+        .map(|e| (e.tick, e.kind))
+        .collect();
+    assert_eq!(
+        kinds,
+        vec![
+            (1, EventKind::Phase(Phase::Slew)),
+            (1, EventKind::BlendRestart)
+        ]
+    );
+    let next = *ctl.step(&sample(2, 20_000.0));
+    assert!(!next.flags.contains(Flags::PHASE_CHANGED));
+    assert!(!next.flags.contains(Flags::BLEND_RESTART));
+    assert_eq!(ctl.pop_event(), None);
+}
+
+#[test]
 fn events_tell_each_change_once_and_count_what_overflows() {
     use tss_reel::controller::{EventKind, EVENT_CAPACITY};
     let mut ctl = paper();

@@ -90,7 +90,7 @@ pub struct History {
 
 /// The controller's flag bits (`tss_reel::controller::Flags`, the `flags` column of
 /// `history.csv`) and their names, in bit order.
-pub const FLAG_NAMES: [(u32, &str); 9] = [
+pub const FLAG_NAMES: [(u32, &str); 11] = [
     (Flags::RATE_SATURATED, "rate-saturated"),
     (Flags::ACCEL_SATURATED, "accel-saturated"),
     (Flags::LENGTH_LIMITED, "length-limited"),
@@ -100,6 +100,8 @@ pub const FLAG_NAMES: [(u32, &str); 9] = [
     (Flags::HEALTH_CHANGED, "health-changed"),
     (Flags::NO_EQUILIBRIUM, "no-equilibrium"),
     (Flags::NO_PROGRESS, "no-progress"),
+    (Flags::TENSION_LIMITED, "tension-limited"),
+    (Flags::PHASE_CHANGED, "phase-changed"),
 ];
 
 /// The names of the bits set in `flags`, joined by `|` (e.g. `slewing|no-equilibrium`;

@@ -117,10 +117,8 @@ pub struct Controller<T: Real> {
     safe_hold_step_mps: T,
     /// The command of the last step, m/s (l̇0 before the first).
     last_rate_cmd_mps: T,
-    /// The health of the last step (a change of health is an event).
+    /// The health of the last step (the `from` of a change of health, an event).
     last_health: Health,
-    /// The phase of the last step (a change of phase is an event).
-    last_phase: Phase,
     /// The fault of the last step (a fault is an event when it differs from the last).
     last_fault: Option<Fault>,
     /// The last step's command was tension limited (the limit beginning is an event).
@@ -180,7 +178,6 @@ impl<T: Real> Controller<T> {
                 * cfg.period_s,
             last_rate_cmd_mps: cfg.initial_rate_mps,
             last_health: Health::Nominal,
-            last_phase: Phase::Deploy,
             last_fault: None,
             last_tension_limited: false,
             events: EventRing::new(),
@@ -394,7 +391,7 @@ impl<T: Real> Controller<T> {
         flags.set_if(reference.slewing, Flags::SLEWING);
         match self
             .sequencer
-            .advance_phase(tick, x.length_m, reference.slewing)
+            .advance_phase(tick, x.length_m, reference.slewing, &mut flags)
         {
             Progress::OnTrack => {}
             Progress::Stalled { first } => {
@@ -626,28 +623,42 @@ impl<T: Real> Controller<T> {
         }
     }
 
-    /// Records a step's events, its changes against the last step, in this order: health
-    /// change, phase change, new fault, blend restart, the tension bound beginning to act. A
-    /// quiet step (the common case) records nothing.
+    /// Records a step's events, in this order: health change, phase change, new fault, blend
+    /// restart, the tension bound beginning to act. A quiet step (the common case) records
+    /// nothing.
     // Inlined into the step (a quiet step's checks without a call): 8 instructions less on the
-    // mission's worst step (scripts/bench-target: 558 → 550). The last step's health and phase
-    // are kept in the controller, not snapshotted before the step and carried across it in
-    // registers (spilled around the law): mission 913/940 → 905/935.
+    // mission's worst step (scripts/bench-target: 558 → 550). The changes are read from the
+    // step's flags, each set where its change happened (health, phase, blend restart, a safe
+    // action for a fault): a quiet step is one test of its flags where comparing the health,
+    // phase, fault and tension limit with the last step's took 23 instructions (mission
+    // median/worst 805/828 → 788/823; the phase's events recorded by the sequencer where it
+    // changes instead: 795/828).
     #[inline(always)]
     fn record_events(&mut self) {
         let out = &self.out;
+        let flags = out.flags;
+        let eventful = Flags::HEALTH_CHANGED
+            | Flags::PHASE_CHANGED
+            | Flags::BLEND_RESTART
+            | Flags::SAFE_ACTION
+            | Flags::TENSION_LIMITED;
+        if flags.0 & eventful == 0 {
+            // No fault without a safe action, no tension limit: both end here.
+            debug_assert!(out.health == self.last_health && out.fault.is_none());
+            self.last_fault = None;
+            self.last_tension_limited = false;
+            return;
+        }
         let tick = out.tick;
-        let (health, phase) = (self.last_health, self.last_phase);
-        self.last_health = out.health;
-        self.last_phase = out.phase;
-        if out.health != health {
+        if flags.contains(Flags::HEALTH_CHANGED) {
             let kind = EventKind::Health {
-                from: health,
+                from: self.last_health,
                 to: out.health,
             };
+            self.last_health = out.health;
             self.events.push(Event { tick, kind });
         }
-        if out.phase != phase {
+        if flags.contains(Flags::PHASE_CHANGED) {
             let kind = EventKind::Phase(out.phase);
             self.events.push(Event { tick, kind });
         }
@@ -658,11 +669,11 @@ impl<T: Real> Controller<T> {
             }
         }
         self.last_fault = out.fault;
-        if out.flags.contains(Flags::BLEND_RESTART) {
+        if flags.contains(Flags::BLEND_RESTART) {
             let kind = EventKind::BlendRestart;
             self.events.push(Event { tick, kind });
         }
-        let tension_limited = out.flags.contains(Flags::TENSION_LIMITED);
+        let tension_limited = flags.contains(Flags::TENSION_LIMITED);
         if tension_limited && !self.last_tension_limited {
             let kind = EventKind::TensionLimited;
             self.events.push(Event { tick, kind });

@@ -88,6 +88,8 @@ impl Flags {
     /// holds the tether in an equilibrium (a sensor bias moves it, HZ-4); stopping the reel
     /// would end the progress for good and can slacken a short tether; the ground decides.
     pub const NO_PROGRESS: u32 = 1 << 8;
+    /// [`Output::phase`] changed at this step.
+    pub const PHASE_CHANGED: u32 = 1 << 10;
     /// The protection's tension bound restricted the command (or its reported acceleration):
     /// the law asked for an acceleration the tether does not carry (docs/equations.md §14).
     pub const TENSION_LIMITED: u32 = Saturation::TENSION;

@@ -237,6 +237,7 @@ impl<T: Real> Sequencer<T> {
             self.stage2 = Stage2Start::Begun;
             self.stage_start_tick = tick;
             self.phase = Phase::Slew;
+            flags.set(Flags::PHASE_CHANGED);
             self.restart_blend(tick, rate_mps, flags);
         }
     }
@@ -350,19 +351,25 @@ impl<T: Real> Sequencer<T> {
     /// capture). The keep phases last until the next stage or the end.
     // One `match` on the phase for both (rather than one to advance it, one to watch it):
     // 5 instructions less on the mission's worst step (scripts/bench-target: 565 → 560).
-    pub(super) fn advance_phase(&mut self, tick: u32, length_m: T, slewing: bool) -> Progress {
+    pub(super) fn advance_phase(
+        &mut self,
+        tick: u32,
+        length_m: T,
+        slewing: bool,
+        flags: &mut Flags,
+    ) -> Progress {
         match self.phase {
-            Phase::Deploy if length_m >= self.keep1_entry_m => self.enter(Phase::Keep1),
+            Phase::Deploy if length_m >= self.keep1_entry_m => self.enter(Phase::Keep1, flags),
             Phase::Deploy => {
                 let distance_m = self.keep1_entry_m - length_m;
                 self.watch(tick, distance_m, self.progress_window_ticks[0])
             }
             Phase::Slew if !slewing => {
-                self.enter(Phase::Retrieve);
+                self.enter(Phase::Retrieve, flags);
                 let distance_m = length_m - self.keep2_entry_m;
                 self.watch(tick, distance_m, self.progress_window_ticks[1])
             }
-            Phase::Retrieve if length_m <= self.keep2_entry_m => self.enter(Phase::Keep2),
+            Phase::Retrieve if length_m <= self.keep2_entry_m => self.enter(Phase::Keep2, flags),
             Phase::Retrieve => {
                 let distance_m = length_m - self.keep2_entry_m;
                 self.watch(tick, distance_m, self.progress_window_ticks[1])
@@ -371,9 +378,11 @@ impl<T: Real> Sequencer<T> {
         }
     }
 
-    /// A new phase: its progress watch starts afresh (a keep phase has none).
-    fn enter(&mut self, phase: Phase) -> Progress {
+    /// A new phase ([`Flags::PHASE_CHANGED`]): its progress watch starts afresh (a keep phase
+    /// has none).
+    fn enter(&mut self, phase: Phase, flags: &mut Flags) -> Progress {
         self.phase = phase;
+        flags.set(Flags::PHASE_CHANGED);
         self.approach = None;
         Progress::OnTrack
     }
