@@ -632,7 +632,8 @@ impl<T: Real> Controller<T> {
     // action for a fault): a quiet step is one test of its flags where comparing the health,
     // phase, fault and tension limit with the last step's took 23 instructions (mission
     // median/worst 805/828 → 788/823; the phase's events recorded by the sequencer where it
-    // changes instead: 795/828).
+    // changes instead: 795/828). A step with the sequencer's events alone (a new phase, a
+    // blend restart) skips the fault and tension comparisons: worst 823 → 813.
     #[inline(always)]
     fn record_events(&mut self) {
         let out = &self.out;
@@ -650,6 +651,20 @@ impl<T: Real> Controller<T> {
             return;
         }
         let tick = out.tick;
+        if flags.0 & (Flags::HEALTH_CHANGED | Flags::SAFE_ACTION | Flags::TENSION_LIMITED) == 0 {
+            // The sequencer's changes alone: a new phase, a blend restart.
+            self.last_fault = None;
+            self.last_tension_limited = false;
+            if flags.contains(Flags::PHASE_CHANGED) {
+                let kind = EventKind::Phase(out.phase);
+                self.events.push(Event { tick, kind });
+            }
+            if flags.contains(Flags::BLEND_RESTART) {
+                let kind = EventKind::BlendRestart;
+                self.events.push(Event { tick, kind });
+            }
+            return;
+        }
         if flags.contains(Flags::HEALTH_CHANGED) {
             let kind = EventKind::Health {
                 from: self.last_health,
