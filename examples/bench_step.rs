@@ -420,12 +420,12 @@ mod bench {
     pub fn primitives(m: &Meter) {
         let sc = m.pure(-1.3_f32, |&x| tss_reel::fastmath::sin_cos(x));
         let fexp = m.pure(-3.2_f32, |&t| tss_reel::fastmath::exp2_and_complement(t));
-        let fsqrt = m.pure(1.7e-7_f32, |&x| tss_reel::fastmath::sqrt(x));
+        let fsqrt = m.pure(1.7e-7_f32, |&x| tss_fpu::sqrt(x));
         let exp = m.pure(-3.2_f32, |&x| libm::expf(x));
         let sqrt = m.pure(1.7e-7_f32, |&x| libm::sqrtf(x));
         let div = m.pure((1.7e-7_f32, 3.1_f32), |&(a, b)| a / b);
         defmt::info!(
-            "primitives (instructions per call): fastmath::sin_cos {=u32}, fastmath::exp2_and_complement {=u32}, fastmath::sqrt {=u32}; libm::expf {=u32}, libm::sqrtf {=u32}; f32 division {=u32}",
+            "primitives (instructions per call): fastmath::sin_cos {=u32}, fastmath::exp2_and_complement {=u32}, tss_fpu::sqrt (VSQRT.F32) {=u32}; libm::expf {=u32}, libm::sqrtf {=u32}; f32 division {=u32}",
             sc,
             fexp,
             fsqrt,

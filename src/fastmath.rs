@@ -19,8 +19,7 @@
 //! ulp of 1. Arguments beyond [`FAST_RANGE`] (never produced by the law: its 2α is within
 //! ±2π, α being checked to |α| ≤ π), infinities and NaN fall back to `libm`.
 //!
-//! [`sqrt`] likewise replaces libm's integer `sqrtf` (≈ 75 instructions on the M4F) with a
-//! bit-pattern estimate and Newton steps, within one ulp of the correctly rounded root.
+//! (The square root is the FPU's own VSQRT.F32 on the MCU: the `tss-fpu` crate.)
 //!
 //! [`exp_and_complement`] (e^x and 1 − e^x; [`exp`] is its first half) is the Cephes `expf`
 //! scheme without libm's general-purpose special-casing: k = round(x/ln 2), r = x − k·ln 2 in
@@ -126,47 +125,6 @@ const fn sin_table() -> [f32; TABLE_LEN] {
         j += 1;
     }
     table
-}
-
-/// √x in single precision without leaving the FPU's precision (libm's `sqrtf` is a bit-serial
-/// integer routine, ~78 instructions on the M4F): a 1/√x estimate from the bit pattern, two
-/// Newton steps, then one Newton step on √x itself. Within one ulp of the rounded √x for every
-/// normal positive x; zero, infinities, negatives and NaN as IEEE 754 defines them, subnormals
-/// within one ulp too (see `sqrt_special`).
-#[inline]
-pub fn sqrt(x: f32) -> f32 {
-    // One unsigned comparison selects the positive normals: their bit patterns are the
-    // contiguous range [MIN_POSITIVE, MAX]; zero, subnormals, infinities, negatives and NaN
-    // all fall outside it.
-    const LOWEST: u32 = f32::MIN_POSITIVE.to_bits();
-    const SPAN: u32 = f32::MAX.to_bits() - LOWEST;
-    let bits = x.to_bits();
-    if bits.wrapping_sub(LOWEST) > SPAN {
-        return sqrt_special(x);
-    }
-    let h = 0.5 * x;
-    // bits < 0x7f80_0000: no wrap-around.
-    let mut r = f32::from_bits(0x5f37_5a86_u32.wrapping_sub(bits >> 1));
-    r = r * (1.5 - h * r * r);
-    r = r * (1.5 - h * r * r);
-    let s = x * r;
-    s + 0.5 * r * (x - s * s)
-}
-
-/// [`sqrt`] of everything but the positive normals, as IEEE 754 defines it: ±0 → ±0,
-/// +∞ → +∞, negatives and NaN → NaN, and a subnormal through the normal path after an exact
-/// scaling by 2²⁴ (√(x·2²⁴)·2⁻¹² = √x; x·2²⁴ ≥ 2⁻¹²⁵ is normal). Out of line: the law never
-/// gets here, and it keeps libm's table-driven `sqrtf` out of the firmware.
-#[inline(never)]
-fn sqrt_special(x: f32) -> f32 {
-    if x > 0.0 && x < f32::MIN_POSITIVE {
-        return sqrt(x * 16_777_216.0) * (1.0 / 4096.0);
-    }
-    if x == 0.0 || x == f32::INFINITY {
-        x
-    } else {
-        f32::NAN
-    }
 }
 
 /// Smallest argument of the fast [`exp`]: e^x stays a normal f32 above it.
@@ -334,44 +292,6 @@ mod tests {
         });
         let (e, at) = worst_error(xs);
         assert!(e < 1.5e-7, "max error {e:e} at x = {at}");
-    }
-
-    #[test]
-    fn sqrt_is_within_one_ulp_of_the_correctly_rounded_root() {
-        // Every 97th f32 bit pattern of the positive normals (≈ 22 million values).
-        let lo = f32::MIN_POSITIVE.to_bits();
-        let hi = f32::MAX.to_bits();
-        for bits in (lo..=hi).step_by(97) {
-            let x = f32::from_bits(bits);
-            let exact = libm::sqrtf(x);
-            let got = sqrt(x);
-            let ulps = (got.to_bits() as i64 - exact.to_bits() as i64).abs();
-            assert!(
-                ulps <= 1,
-                "sqrt({x:e}) = {got:e}, correctly rounded {exact:e}"
-            );
-        }
-        for x in [
-            0.0_f32,
-            -0.0,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            -1.0,
-            -1e-40,
-            f32::NAN,
-        ] {
-            let (a, b) = (sqrt(x), libm::sqrtf(x));
-            assert!(
-                a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
-                "{x}"
-            );
-        }
-        // Every subnormal: within one ulp.
-        for bits in 1..f32::MIN_POSITIVE.to_bits() {
-            let x = f32::from_bits(bits);
-            let ulps = (sqrt(x).to_bits() as i64 - libm::sqrtf(x).to_bits() as i64).abs();
-            assert!(ulps <= 1, "sqrt({x:e})");
-        }
     }
 
     /// Distance in ulps between `got` and the correctly rounded `exact` (same sign, finite).

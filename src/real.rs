@@ -154,7 +154,7 @@ impl Real for f32 {
     }
     #[inline]
     fn sqrt(self) -> Self {
-        crate::fastmath::sqrt(self)
+        tss_fpu::sqrt(self)
     }
     #[inline]
     fn abs(self) -> Self {

@@ -49,6 +49,25 @@ mod tests {
     use tss_reel::orbit::circular_rate_radps;
 
     #[test]
+    fn the_fpu_square_root_is_correctly_rounded() {
+        // VSQRT.F32 (tss_fpu::sqrt on this target) against libm's f64 root rounded once to f32,
+        // the correctly rounded one (53 ≥ 2·24 + 2): every 65 521st bit pattern from the
+        // smallest subnormal to the largest finite float, and the special values.
+        let mut bits = 1_u32;
+        while bits < f32::MAX.to_bits() {
+            let x = f32::from_bits(bits);
+            let expected = libm::sqrt(f64::from(x)) as f32;
+            defmt::assert_eq!(tss_fpu::sqrt(x).to_bits(), expected.to_bits());
+            bits += 65_521;
+        }
+        defmt::assert_eq!(tss_fpu::sqrt(0.0).to_bits(), 0.0_f32.to_bits());
+        defmt::assert_eq!(tss_fpu::sqrt(-0.0).to_bits(), (-0.0_f32).to_bits());
+        defmt::assert_eq!(tss_fpu::sqrt(f32::INFINITY), f32::INFINITY);
+        defmt::assert!(tss_fpu::sqrt(-1.0).is_nan());
+        defmt::assert!(tss_fpu::sqrt(f32::NAN).is_nan());
+    }
+
+    #[test]
     fn orbit_rate_of_paper_orbit_in_f32() {
         // n = √(μ/R³) = 1.060 237 e-3 rad/s; f32 resolves ~1e-10 here.
         let n = circular_rate_radps::<f32>(R_PAPER_M);
