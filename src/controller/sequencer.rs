@@ -83,12 +83,15 @@ struct BlendStart<T> {
     weight_low: T,
 }
 
-/// What one period does to a stage's Eq. 29 blend, worked out in f64 and rounded once.
+/// What one period does to a stage's Eq. 29 blend.
 #[derive(Clone, Copy, Debug)]
 struct BlendPerTick<T> {
-    /// −cΔt·log₂e: E = e^{−cΔt·k} = 2^{−cΔt·log₂e·k} k ticks after the start.
+    /// −cΔt·log₂e: E = e^{−cΔt·k} = 2^{−cΔt·log₂e·k} k ticks after the start (in f64,
+    /// rounded once).
     log2_weight: T,
-    /// 1 − e^{−cΔt}: the share of E that one period moves to 1 − E.
+    /// 1 − e^{−cΔt}: the share of E that one period moves to 1 − E, to its own precision
+    /// ([`Real::exp_and_complement`]: in f32 within two ulps; libm's f64 `expm1` would add
+    /// 1.7 KB of soft-float code to the firmware).
     decayed_share: T,
 }
 
@@ -98,7 +101,7 @@ impl<T: Real> BlendPerTick<T> {
         let c_dt = decay_rate_per_s.to_f64() * period_s.to_f64();
         Self {
             log2_weight: T::from_f64(-c_dt * core::f64::consts::LOG2_E),
-            decayed_share: T::from_f64(-libm::expm1(-c_dt)),
+            decayed_share: T::from_f64(-c_dt).exp_and_complement().1,
         }
     }
 }
