@@ -402,11 +402,14 @@ pub struct SpeedLoop {
     /// The faults every step reports until the next command: [`DriveFault::CommandInvalid`]
     /// after a non-finite one, none otherwise.
     command_faults: DriveFaults,
-    /// The reference's ramp now.
+    /// The reference's ramp: with the brake free, from the reference at the command's
+    /// arrival; otherwise from rest, its `start_tick` set when the brake is free (the drum was
+    /// held until then). Worked out with the command (and again by `clear_trip`), so that the
+    /// release's step has no division and sets one field (a second ramp from rest, kept
+    /// beside this one and copied in at the release, made that step the mission's worst, 14
+    /// instructions above the next one; 7 above it this way, exact, `scripts/bench-target`
+    /// with `TSS_BENCH_EXACT=1`; `set_command` works out one ramp instead of two).
     ramp: Ramp,
-    /// The ramp from rest to the command (its `start_tick` set when the brake is free): worked
-    /// out with the command, so that the release's step has no division.
-    ramp_from_rest: Ramp,
     integral_nm: f32,
     /// A step has been taken, so the output's `tick` is the last step's tick (kept once,
     /// there: an `Option` of it beside the output cost the step a store, 2 instructions on the
@@ -449,7 +452,6 @@ impl SpeedLoop {
             command_moving: false,
             command_faults: DriveFaults::NONE,
             ramp: Ramp::REST,
-            ramp_from_rest: Ramp::REST,
             integral_nm: 0.0,
             stepped: false,
             stall_ticks: 0,
@@ -526,9 +528,11 @@ impl SpeedLoop {
             }
         };
         self.command_moving = self.command.rate_mps.abs() > self.cfg.brake.rest_speed_mps;
-        let (now_mps, _) = self.reference_at(tick);
-        self.ramp = self.ramp_toward_command(now_mps, tick);
-        self.ramp_from_rest = self.ramp_toward_command(0.0, tick);
+        let from_mps = match self.out.brake {
+            Brake::Released { .. } => self.reference_at(tick).0,
+            Brake::Engaged | Brake::Releasing { .. } | Brake::Tripped(_) => 0.0,
+        };
+        self.ramp = self.ramp_toward_command(from_mps, tick);
         if valid {
             Ok(())
         } else {
@@ -557,6 +561,8 @@ impl SpeedLoop {
                 self.stall_ticks = 0;
                 self.saturated_ticks = 0;
                 self.odometer.resync();
+                // The drum was held: the next release starts the ramp from rest.
+                self.ramp = self.ramp_toward_command(0.0, 0);
                 Some(f)
             }
             _ => None,
@@ -592,16 +598,22 @@ impl SpeedLoop {
         };
         let (counted, speed_mps) = self.odometer.update_after(tick, gap_ticks, reading);
         if let Err(f) = counted {
-            let fault = match f {
-                CountFault::Jump => DriveFault::EncoderJump,
-                CountFault::Missing => DriveFault::EncoderMissing,
+            let since_accepted = self.odometer.ticks_since_accepted(tick);
+            let (fault, lost) = match f {
+                // (A jump is a reading within the gap the check bridges, against an accepted
+                // one: only the ticks since that one can have run out. Telling the two apart
+                // here, every fault branch of one step 224 → 219, exact, `scripts/bench-target`
+                // with `TSS_BENCH_EXACT=1`.)
+                CountFault::Jump => (
+                    DriveFault::EncoderJump,
+                    since_accepted.is_some_and(|t| t > trip_ticks),
+                ),
+                CountFault::Missing => (
+                    DriveFault::EncoderMissing,
+                    gap_ticks > trip_ticks || since_accepted.is_some_and(|t| t > trip_ticks),
+                ),
             };
             faults.insert(fault);
-            let lost = gap_ticks > trip_ticks
-                || self
-                    .odometer
-                    .ticks_since_accepted(tick)
-                    .is_some_and(|t| t > trip_ticks);
             if lost {
                 self.trip(fault);
             }
@@ -621,6 +633,14 @@ impl SpeedLoop {
                     // or the other: 12 instructions less on its worst path,
                     // `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
                     self.stall_ticks = 0;
+                    law
+                } else if counted.is_err() {
+                    // No measured motion this tick (its reading rejected or missing, the speed
+                    // held): the stall is judged on measured motion, so the tick neither counts
+                    // toward a stall nor clears one, as the brake's rest count (and the fault
+                    // paths of a jump and of a stall's or rest's count are not paid in one
+                    // tick: every fault branch of one step 212 → 208, exact,
+                    // `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
                     law
                 } else if self.count_stall(gap_ticks, speed_mps, law.2) {
                     faults.insert(DriveFault::MotorStall);
@@ -809,10 +829,8 @@ impl SpeedLoop {
                 if !target_moving || hold {
                     Brake::Engaged
                 } else if ticks_left <= gap_ticks {
-                    self.ramp = Ramp {
-                        start_tick: tick,
-                        ..self.ramp_from_rest
-                    };
+                    // (The ramp is from rest: the brake was not free at the command.)
+                    self.ramp.start_tick = tick;
                     Brake::Released { rest_ticks: 0 }
                 } else {
                     Brake::Releasing {
@@ -821,6 +839,11 @@ impl SpeedLoop {
                 }
             }
             Brake::Released { ref mut rest_ticks } => {
+                if !counted {
+                    // No measured motion (the speed held): the rest count neither advances
+                    // nor restarts, as the stall's (see the step).
+                    return;
+                }
                 // At rest: the command is rest and the drum is at rest (its reference, which
                 // it follows, is on its way there; waiting for it as well made the step's
                 // worst path 5 instructions longer, `examples/bench_speed_loop.rs`).
@@ -893,16 +916,29 @@ impl SpeedLoop {
 /// fails both comparisons of the in-range test, so a value inside the limits takes two
 /// comparisons and no NaN test (6 instructions less on the step's unsaturated path than
 /// testing for NaN after the two bounds, `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
+/// The lower bound first: a saturation either way takes two comparisons too (the upper bound
+/// first, one above and three below: every fault branch of one step 208 → 206, exact).
 fn saturate(x: f32, limit: f32) -> (f32, bool) {
-    if x > limit {
-        (limit, true)
-    } else if x >= -limit {
-        (x, false)
+    if x >= -limit {
+        if x > limit {
+            (limit, true)
+        } else {
+            (x, false)
+        }
     } else if x < -limit {
         (-limit, true)
     } else {
-        (0.0, false)
+        nan_duty()
     }
+}
+
+/// [`saturate`]'s NaN: no torque. Cold and out of line, so that the saturation's branches
+/// stay branches (if-converted by LLVM, they cost every step 11 instructions more, exact,
+/// `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
+#[cold]
+#[inline(never)]
+fn nan_duty() -> (f32, bool) {
+    (0.0, false)
 }
 
 /// [`saturate`]'s value.
@@ -952,7 +988,9 @@ mod tests {
         assert_eq!(s.reference_at(500), (0.5, 1.0));
         assert_eq!(s.reference_at(1000), (1.0, 0.0));
         assert_eq!(s.reference_at(5000), (1.0, 0.0));
-        // An acceleration pointing away from the command does not move the reference away.
+        // With the brake free, the next command ramps from the reference; an acceleration
+        // pointing away from the command does not move the reference away.
+        s.out.brake = Brake::Released { rest_ticks: 0 };
         s.set_command(
             RateCommand {
                 rate_mps: 0.5,
@@ -964,6 +1002,83 @@ mod tests {
         .unwrap();
         let (v, a) = s.reference_at(1500);
         assert!((v - 0.75).abs() < 1e-6 && a == -0.5, "{v} {a}");
+    }
+
+    #[test]
+    fn the_ramp_starts_from_rest_at_every_release() {
+        let mut s = SpeedLoop::new(DriveConfig::example()).unwrap();
+        let input = |tick| DriveInput {
+            tick,
+            encoder_count: Some(0),
+            tension_n: Some(20.0),
+        };
+        // 1 m/s at 1 m/s², commanded while the brake is on: the ramp starts at the release.
+        s.set_command(
+            RateCommand {
+                rate_mps: 1.0,
+                accel_mps2: 1.0,
+                safe_hold: false,
+            },
+            0,
+        )
+        .unwrap();
+        let mut tick = 0;
+        while !matches!(s.step(&input(tick)).brake, Brake::Released { .. }) {
+            tick += 1;
+        }
+        let released = tick;
+        assert!(released > 0);
+        assert_eq!(s.output().ref_rate_mps, 0.0);
+        for t in released + 1..=released + 500 {
+            s.step(&input(t));
+        }
+        assert!((s.output().ref_rate_mps - 0.5).abs() < 1e-6);
+        // Tripped mid-ramp and cleared, under the same command: the drum was held, so the
+        // next release starts the ramp from rest again (not from where it stood).
+        s.trip(DriveFault::Actuator);
+        s.clear_trip();
+        let mut tick = released + 501;
+        while !matches!(s.step(&input(tick)).brake, Brake::Released { .. }) {
+            tick += 1;
+        }
+        assert_eq!(s.output().ref_rate_mps, 0.0);
+        for t in tick + 1..=tick + 100 {
+            s.step(&input(t));
+        }
+        assert!((s.output().ref_rate_mps - 0.1).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_tick_without_a_measured_speed_neither_counts_toward_a_stall_nor_clears_it() {
+        let mut s = SpeedLoop::new(DriveConfig::example()).unwrap();
+        s.set_command(
+            RateCommand {
+                rate_mps: 1.0,
+                accel_mps2: 0.0,
+                safe_hold: false,
+            },
+            0,
+        )
+        .unwrap();
+        // A still drum under the largest tension: the duty saturates, a stall is counted.
+        let input = |tick, encoder_count| DriveInput {
+            tick,
+            encoder_count,
+            tension_n: Some(200.0),
+        };
+        let mut tick = 0;
+        while !matches!(s.step(&input(tick, Some(0))).brake, Brake::Released { .. }) {
+            tick += 1;
+        }
+        let counted = s.stall_ticks;
+        assert!(counted > 0);
+        tick += 1;
+        let out = *s.step(&input(tick, None));
+        assert!(out.faults.contains(DriveFault::EncoderMissing));
+        assert_eq!(s.stall_ticks, counted);
+        tick += 1;
+        s.step(&input(tick, Some(0)));
+        assert_eq!(s.stall_ticks, counted + 1);
     }
 
     #[test]
