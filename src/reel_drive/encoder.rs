@@ -117,26 +117,25 @@ impl Odometer {
     /// Takes the counter reading of `tick` (`None`: no reading). Ticks must increase (the
     /// speed loop checks that before it calls this). The first reading sets the origin.
     pub fn update(&mut self, tick: u32, raw: Option<u32>) -> Result<(), CountFault> {
-        self.update_after(tick, tick.wrapping_sub(self.last_tick), raw)
-            .0
+        let gap_ticks = tick.wrapping_sub(self.last_tick);
+        if gap_ticks != 1 {
+            self.skip(gap_ticks.wrapping_sub(1));
+        }
+        self.update_next(tick, raw).0
     }
 
-    /// [`update`](Self::update) for a caller that knows the ticks since the last update,
-    /// `gap_ticks` (the speed loop's step has just checked them; with the step's counters added
-    /// without saturating, 2 instructions less on the benchmark's worst paths than working
-    /// them out again, 240 → 238 and 208 → 206, `scripts/bench-target` with
+    /// [`update`](Self::update) for the tick after the last update's, or after the ticks
+    /// [`skip`](Self::skip) gave their totals (the speed loop's step knows the gap, and
+    /// tells an overrun apart once, with its test of the gap against the encoder trip's:
+    /// against this function's own test, every fault branch of one step 213 → 205, the
+    /// mission's worst 196 → 189 and mean 166.9 → 159.1, exact, `scripts/bench-target` with
     /// `TSS_BENCH_EXACT=1`). Returns the drum speed after it as well
     /// ([`speed_mps`](Self::speed_mps)).
-    pub(super) fn update_after(
+    pub(super) fn update_next(
         &mut self,
         tick: u32,
-        gap_ticks: u32,
         raw: Option<u32>,
     ) -> (Result<(), CountFault>, f32) {
-        // Ticks skipped since the last update (rare: an overrun) get the predicted total.
-        if gap_ticks != 1 {
-            self.fill_skipped(gap_ticks.wrapping_sub(1));
-        }
         self.last_tick = tick;
         let result = self.count(tick, raw);
         let now = match result {
@@ -159,11 +158,12 @@ impl Odometer {
         (result, self.speed_mps())
     }
 
-    /// Gives the `skipped` ticks after `last_tick` their predicted totals. Out of line and
-    /// cold: an overrun is rare, and its loop kept inline costs the nominal step registers.
+    /// Gives the `skipped` ticks after the last update their predicted totals (ticks skipped
+    /// by an overrun). Out of line and cold: an overrun is rare, and its loop kept inline costs
+    /// the nominal step registers.
     #[cold]
     #[inline(never)]
-    fn fill_skipped(&mut self, skipped: u32) {
+    pub(super) fn skip(&mut self, skipped: u32) {
         for _ in 0..skipped.min(RING as u32) {
             self.last_tick = self.last_tick.wrapping_add(1);
             self.last.total = self.predicted_total();
