@@ -416,7 +416,12 @@ pub struct SpeedLoop {
     /// mission's worst path, `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
     stepped: bool,
     stall_ticks: u32,
-    saturated_ticks: u32,
+    /// Ticks of duty saturation left before [`DriveFault::DutySaturated`] is reported (the
+    /// configuration's `saturation_ticks` while unsaturated, 0 once reported): counted down,
+    /// so that a saturated step does not load the limit (3 instructions less on it than
+    /// counting up, saturating, and comparing, exact, `scripts/bench-target` with
+    /// `TSS_BENCH_EXACT=1`).
+    saturation_left_ticks: u32,
     /// The last step's output. Its `brake` is the brake's state, which the step, `trip` and
     /// `clear_trip` change in place, and its `tension_n` the tension the feed-forward uses
     /// (the last good reading, clamped into range), which `tension` keeps (a copy of each
@@ -455,7 +460,7 @@ impl SpeedLoop {
             integral_nm: 0.0,
             stepped: false,
             stall_ticks: 0,
-            saturated_ticks: 0,
+            saturation_left_ticks: cfg.faults.saturation_ticks,
             out: DriveOutput::IDLE,
         })
     }
@@ -559,7 +564,7 @@ impl SpeedLoop {
             Brake::Tripped(f) => {
                 self.out.brake = Brake::Engaged;
                 self.stall_ticks = 0;
-                self.saturated_ticks = 0;
+                self.saturation_left_ticks = self.cfg.faults.saturation_ticks;
                 self.odometer.resync();
                 // The drum was held: the next release starts the ramp from rest.
                 self.ramp = self.ramp_toward_command(0.0, 0);
@@ -678,12 +683,12 @@ impl SpeedLoop {
         // Saturation held too long (reported); the stall is `count_stall`'s.
         let f = &self.cfg.faults;
         if saturated {
-            self.saturated_ticks = self.saturated_ticks.saturating_add(gap_ticks);
-            if self.saturated_ticks >= f.saturation_ticks {
+            self.saturation_left_ticks = self.saturation_left_ticks.saturating_sub(gap_ticks);
+            if self.saturation_left_ticks == 0 {
                 faults.insert(DriveFault::DutySaturated);
             }
         } else {
-            self.saturated_ticks = 0;
+            self.saturation_left_ticks = f.saturation_ticks;
         }
 
         // (The brake and the tension are in place.)
