@@ -399,6 +399,9 @@ pub struct SpeedLoop {
     command: RateCommand,
     /// The command asks for motion: |rate| above the brake's rest speed.
     command_moving: bool,
+    /// The command lets the brake be free: moving, and not in safe hold (worked out with the
+    /// command: one test on the brake's engaged and releasing steps instead of two).
+    command_frees_brake: bool,
     /// The faults every step reports until the next command: [`DriveFault::CommandInvalid`]
     /// after a non-finite one, none otherwise.
     command_faults: DriveFaults,
@@ -455,6 +458,7 @@ impl SpeedLoop {
                 safe_hold: false,
             },
             command_moving: false,
+            command_frees_brake: false,
             command_faults: DriveFaults::NONE,
             ramp: Ramp::REST,
             integral_nm: 0.0,
@@ -533,6 +537,7 @@ impl SpeedLoop {
             }
         };
         self.command_moving = self.command.rate_mps.abs() > self.cfg.brake.rest_speed_mps;
+        self.command_frees_brake = self.command_moving && !self.command.safe_hold;
         let from_mps = match self.out.brake {
             Brake::Released { .. } => self.reference_at(tick).0,
             Brake::Engaged | Brake::Releasing { .. } | Brake::Tripped(_) => 0.0,
@@ -826,12 +831,12 @@ impl SpeedLoop {
     /// Entering `Released` starts the ramp from rest at `tick` (the drum was held until now).
     /// At rest means the command and the measured speed ~0.
     fn advance_brake(&mut self, tick: u32, gap_ticks: u32, speed_mps: f32, counted: bool) {
-        let hold = self.command.safe_hold;
+        let frees = self.command_frees_brake;
         let target_moving = self.command_moving;
         let next = match self.out.brake {
             Brake::Tripped(_) => return,
             Brake::Engaged => {
-                if target_moving && !hold && counted {
+                if frees && counted {
                     Brake::Releasing {
                         ticks_left: self.cfg.brake.release_ticks,
                     }
@@ -840,7 +845,7 @@ impl SpeedLoop {
                 }
             }
             Brake::Releasing { ticks_left } => {
-                if !target_moving || hold {
+                if !frees {
                     Brake::Engaged
                 } else if ticks_left <= gap_ticks {
                     // (The ramp is from rest: the brake was not free at the command.)
