@@ -813,7 +813,12 @@ impl SpeedLoop {
                 }
                 faults.insert(DriveFault::TensionOutOfRange);
             }
-            Some(t) if t >= lo => self.out.tension_n = t,
+            Some(t) if t >= lo => {
+                // (Returned as well as kept: the nominal step 1 instruction shorter than
+                // reading it back, mission mean 158.6 → 157.6, exact.)
+                self.out.tension_n = t;
+                return t;
+            }
             Some(t) => {
                 if t > f32::NEG_INFINITY {
                     self.out.tension_n = lo;
