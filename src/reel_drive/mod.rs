@@ -383,10 +383,6 @@ struct Derived {
     coulomb_per_band: f32,
     /// 1 / τ_max: duty per N m.
     per_max_torque: f32,
-    /// The stall duty as a torque, stall duty × τ_max, N m: the stall check compares the
-    /// torque with it, without working out the duty twice (2 instructions less on the stall
-    /// path, `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
-    stall_torque_nm: f32,
 }
 
 /// The inner speed loop with its brake and fault logic.
@@ -446,7 +442,6 @@ impl SpeedLoop {
             viscous_per_radius: cfg.drum.viscous_nm_per_radps / r,
             coulomb_per_band: cfg.drum.coulomb_nm / cfg.drum.coulomb_band_mps,
             per_max_torque: 1.0 / cfg.max_torque_nm,
-            stall_torque_nm: cfg.faults.stall_duty * cfg.max_torque_nm,
         };
         Ok(Self {
             cfg,
@@ -641,9 +636,18 @@ impl SpeedLoop {
 
         // The torque: PI + feed-forward with the brake free; while it lifts, the motor takes
         // over the tension's torque, nothing else; otherwise the motor is off.
-        let (ref_mps, ref_accel_mps2, torque_nm) = match self.out.brake {
+        let limit = self.cfg.duty_limit;
+        let per_max_torque = self.derived.per_max_torque;
+        let (ref_mps, ref_accel_mps2, torque_nm, (duty, saturated)) = match self.out.brake {
             Brake::Released { rest_ticks } => {
-                let law = self.speed_law(tick, gap_ticks, speed_mps, tension_n);
+                let (ref_mps, ref_accel_mps2, torque_nm) =
+                    self.speed_law(tick, gap_ticks, speed_mps, tension_n);
+                let law = (
+                    ref_mps,
+                    ref_accel_mps2,
+                    torque_nm,
+                    saturate(torque_nm * per_max_torque, limit),
+                );
                 if rest_ticks > 0 {
                     // At rest, the brake about to engage: a large duty holding a still drum
                     // is the motor holding the tension, not a stall (and the step counts one
@@ -659,31 +663,35 @@ impl SpeedLoop {
                     // tick: every fault branch of one step 212 → 208, exact,
                     // `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
                     law
-                } else if self.count_stall(gap_ticks, speed_mps, law.2) {
+                } else if self.count_stall(gap_ticks, speed_mps, law.3) {
                     faults.insert(DriveFault::MotorStall);
-                    (law.0, law.1, 0.0)
+                    (law.0, law.1, 0.0, (0.0, false))
                 } else {
                     law
                 }
             }
             Brake::Releasing { .. } => {
                 self.stall_ticks = 0;
-                (0.0, 0.0, self.tension_torque_nm(tension_n))
+                let torque_nm = self.tension_torque_nm(tension_n);
+                (
+                    0.0,
+                    0.0,
+                    torque_nm,
+                    saturate(torque_nm * per_max_torque, limit),
+                )
             }
             Brake::Engaged => {
                 self.stall_ticks = 0;
                 self.integral_nm = 0.0;
-                (0.0, 0.0, 0.0)
+                (0.0, 0.0, 0.0, (0.0, false))
             }
             Brake::Tripped(f) => {
                 faults.insert(f);
                 self.stall_ticks = 0;
                 self.integral_nm = 0.0;
-                (0.0, 0.0, 0.0)
+                (0.0, 0.0, 0.0, (0.0, false))
             }
         };
-        let (duty, saturated) =
-            saturate(torque_nm * self.derived.per_max_torque, self.cfg.duty_limit);
 
         // Saturation held too long (reported); the stall is `count_stall`'s.
         let f = &self.cfg.faults;
@@ -760,9 +768,20 @@ impl SpeedLoop {
     /// otherwise; at the stall ticks it trips the drive (returns true: the step's torque is
     /// then 0). Run from the `Released` arm of the step, it needs no test of the brake's state
     /// (the other arms reset the counter), and the threshold is compared only while counting.
-    fn count_stall(&mut self, gap_ticks: u32, speed_mps: f32, torque_nm: f32) -> bool {
+    /// It takes the duty after saturation: a saturated one is large without a comparison (the
+    /// torque compared with the stall duty's before saturation: every fault branch of one step
+    /// 200 → 194, for the unsaturated stall's count at the mission's stop 187 → 192, exact,
+    /// `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
+    fn count_stall(
+        &mut self,
+        gap_ticks: u32,
+        speed_mps: f32,
+        (duty, saturated): (f32, bool),
+    ) -> bool {
         let f = &self.cfg.faults;
-        if torque_nm.abs() >= self.derived.stall_torque_nm && speed_mps.abs() <= f.stall_speed_mps {
+        // (A saturated duty is at the limit, at or above the stall duty: validated.)
+        let large = saturated || duty.abs() >= f.stall_duty;
+        if large && speed_mps.abs() <= f.stall_speed_mps {
             // (Cannot wrap: below `stall_ticks` ≤ 2³¹ − 1, plus a gap below 2³¹; added
             // without saturating, as the rest count, 2 instructions less on the benchmark's
             // worst paths, 240 → 238 and 208 → 206, `scripts/bench-target` with
