@@ -320,6 +320,7 @@ fn main() -> ! {
             5200 => t.tension_n = Some(f32::NAN),
             5201 => t.tension_n = None,
             5202 => t.tension_n = Some(1e6),
+            5203 => t.tension_n = Some(-1e6),
             // A counter that lost counts for good: jumps until the encoder trip.
             11_000.. => t.count_offset = 20_000,
             _ => {}
@@ -344,8 +345,12 @@ fn main() -> ! {
             2000 | 4000 | 4900 => Action::ClearTrip,
             _ => Action::None,
         });
-        let overload = (1000..2000).contains(&tick)
-            || (3000..4000).contains(&tick)
+        // (A slack reading, below the range, while the drum is first jammed: the tension's
+        // longest arm, with the stall's count and the saturation's the other way.)
+        if (1000..2000).contains(&tick) {
+            t.tension_n = Some(-1e6);
+        }
+        let overload = (3000..4000).contains(&tick)
             || (4100..4900).contains(&tick)
             || tick >= 5000;
         if overload {
