@@ -350,9 +350,7 @@ fn main() -> ! {
         if (1000..2000).contains(&tick) {
             t.tension_n = Some(-1e6);
         }
-        let overload = (3000..4000).contains(&tick)
-            || (4100..4900).contains(&tick)
-            || tick >= 5000;
+        let overload = (3000..4000).contains(&tick) || (4100..4900).contains(&tick) || tick >= 5000;
         if overload {
             t.tension_n = Some(1e6);
         }

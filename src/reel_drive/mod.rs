@@ -839,7 +839,10 @@ impl SpeedLoop {
                 return t;
             }
             Some(t) => {
-                if t > f32::NEG_INFINITY {
+                // (Below `lo` or NaN: finite and not NaN if at or above the lowest finite
+                // value; one branch, where `t > −∞` took two and a jump, the slack reading's
+                // step 186 → 184, exact.)
+                if t >= f32::MIN {
                     self.out.tension_n = lo;
                 }
                 faults.insert(DriveFault::TensionOutOfRange);
