@@ -14,7 +14,8 @@
 //! 3. `worst`: every arm's worst path, the fault branches of one step together: encoder jumps
 //!    (one tick in three) and an overload tension on a jammed drum, through the stall's count
 //!    and trip, the tripped state, a brake release, the brake's rest count while the stall and
-//!    saturation counters run, and the encoder trip (6 000 ticks).
+//!    saturation counters run, a release on the jammed drum under the overload (the stall's
+//!    and the saturation's counts on the release's tick), and the encoder trip (6 000 ticks).
 //!
 //! Run it (after `scripts/setup`) with
 //!
@@ -319,6 +320,7 @@ fn main() -> ! {
             5200 => t.tension_n = Some(f32::NAN),
             5201 => t.tension_n = None,
             5202 => t.tension_n = Some(1e6),
+            5203 => t.tension_n = Some(-1e6),
             // A counter that lost counts for good: jumps until the encoder trip.
             11_000.. => t.count_offset = 20_000,
             _ => {}
@@ -330,17 +332,25 @@ fn main() -> ! {
     // (rejected, its total predicted, no trip): a moving command until the stall trips (then
     // tripped, with the same faults); cleared, back to normal tension; then a rest command on
     // the jammed drum, so the brake counts its rest ticks while the stall and saturation
-    // counters run; cleared again; a counter that lost counts for good until the encoder trip,
-    // under the overload.
+    // counters run; cleared again; a moving command on the jammed drum under the overload, so
+    // that the brake's release (the reference at rest, inside the Coulomb band) comes with the
+    // stall's count and the saturation's, until the stall trips; cleared again; a counter that
+    // lost counts for good until the encoder trip, under the overload.
     bench::measure(&meter, "worst", 6_000, |tick| {
         let mut t = quiet(match tick {
             0 => Action::Command(0.5, 0.0),
             1000 => Action::Jam,
             3000 => Action::JamAndCommand(0.0, -5.0),
-            2000 | 4000 => Action::ClearTrip,
+            4100 => Action::JamAndCommand(0.5, 0.0),
+            2000 | 4000 | 4900 => Action::ClearTrip,
             _ => Action::None,
         });
-        let overload = (1000..2000).contains(&tick) || (3000..4000).contains(&tick) || tick >= 5000;
+        // (A slack reading, below the range, while the drum is first jammed: the tension's
+        // longest arm, with the stall's count and the saturation's the other way.)
+        if (1000..2000).contains(&tick) {
+            t.tension_n = Some(-1e6);
+        }
+        let overload = (3000..4000).contains(&tick) || (4100..4900).contains(&tick) || tick >= 5000;
         if overload {
             t.tension_n = Some(1e6);
         }

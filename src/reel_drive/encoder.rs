@@ -11,9 +11,9 @@
 //!   difference of integers, so the quantisation is one count over W ticks (15.3 µm / 8 ms ≈
 //!   1.9 mm/s for [`DriveConfig::example`]) and nothing is integrated. The totals are kept
 //!   per tick in a ring indexed by the tick. A tick without an accepted reading (missing,
-//!   rejected, or skipped by an overrun) gets the total the window's speed predicts (its mean
-//!   change per tick, a shift: W is a power of two), so the speed holds through it instead of
-//!   dipping; the next accepted reading brings the true total back.
+//!   rejected, or skipped by an overrun) holds the speed of the last accepted one, and gets
+//!   the total that speed predicts (the window's mean change per tick, a shift: W is a power
+//!   of two), so the speed does not dip; the next accepted reading brings the true total back.
 //!
 //! A reading that moved further than the drum can turn in the ticks since the last accepted
 //! one (at [`FaultLimits::max_encoder_rate_mps`]) is an encoder jump: it is rejected, the total
@@ -64,6 +64,24 @@ pub struct Odometer {
     /// (the window's difference of two of them is exact: it is bounded by the jump check, far
     /// below 2³¹).
     totals: [u32; RING],
+    /// The window's last measurement, kept beside the ring (see [`Window`]).
+    last: Window,
+}
+
+/// The total at `last_tick` and the window's change at the last accepted reading: what the
+/// speed and a tick without an accepted reading need, kept rather than read back from the
+/// ring. A tick without an accepted reading predicts its total from them and holds the speed
+/// (the ring's three loads and their indices made such a tick, an encoder jump or a missing
+/// count, 25 instructions longer than a nominal one: every fault branch of one step 219 →
+/// 208, for 3 more on the nominal step, mission mean 158.7 → 161.7, exact,
+/// `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Window {
+    /// The total at `last_tick`, modulo 2³² (the ring's slot of `last_tick`).
+    total: u32,
+    /// The total's change over the window ending at the last accepted reading, counts (0 until
+    /// the second reading, and after a [`resync`](Odometer::resync)).
+    change: i32,
 }
 
 /// The last accepted reading.
@@ -89,74 +107,78 @@ impl Odometer {
             total_counts: 0,
             last_tick: 0,
             totals: [0; RING],
+            last: Window {
+                total: 0,
+                change: 0,
+            },
         }
     }
 
     /// Takes the counter reading of `tick` (`None`: no reading). Ticks must increase (the
     /// speed loop checks that before it calls this). The first reading sets the origin.
     pub fn update(&mut self, tick: u32, raw: Option<u32>) -> Result<(), CountFault> {
-        self.update_after(tick, tick.wrapping_sub(self.last_tick), raw)
-            .0
+        let gap_ticks = tick.wrapping_sub(self.last_tick);
+        if gap_ticks != 1 {
+            self.skip(gap_ticks.wrapping_sub(1));
+        }
+        self.update_next(tick, raw).0
     }
 
-    /// [`update`](Self::update) for a caller that knows the ticks since the last update,
-    /// `gap_ticks` (the speed loop's step has just checked them; with the step's counters added
-    /// without saturating, 2 instructions less on the benchmark's worst paths than working
-    /// them out again, 240 → 238 and 208 → 206, `scripts/bench-target` with
-    /// `TSS_BENCH_EXACT=1`). Returns the drum speed after it as well, worked out from the total
-    /// just written rather than read back ([`speed_mps`](Self::speed_mps)).
-    pub(super) fn update_after(
+    /// [`update`](Self::update) for the tick after the last update's, or after the ticks
+    /// [`skip`](Self::skip) gave their totals (the speed loop's step knows the gap, and
+    /// tells an overrun apart once, with its test of the gap against the encoder trip's:
+    /// against this function's own test, every fault branch of one step 213 → 205, the
+    /// mission's worst 196 → 189 and mean 166.9 → 159.1, exact, `scripts/bench-target` with
+    /// `TSS_BENCH_EXACT=1`). Returns the drum speed after it as well
+    /// ([`speed_mps`](Self::speed_mps)).
+    pub(super) fn update_next(
         &mut self,
         tick: u32,
-        gap_ticks: u32,
         raw: Option<u32>,
     ) -> (Result<(), CountFault>, f32) {
-        // Ticks skipped since the last update (rare: an overrun) get the predicted total.
-        if gap_ticks != 1 {
-            self.fill_skipped(gap_ticks.wrapping_sub(1));
-        }
         self.last_tick = tick;
         let result = self.count(tick, raw);
         let now = match result {
-            Ok(()) => self.total_counts as u32,
-            Err(_) => self.unread_total(),
+            Ok(()) => {
+                let now = self.total_counts as u32;
+                let then = self.totals[tick.wrapping_sub(self.window) as usize % RING];
+                self.last = Window {
+                    total: now,
+                    change: now.wrapping_sub(then) as i32,
+                };
+                now
+            }
+            Err(_) => {
+                let now = self.predicted_total();
+                self.last.total = now;
+                now
+            }
         };
         self.totals[tick as usize % RING] = now;
-        (result, self.speed_at(now))
+        (result, self.speed_mps())
     }
 
-    /// Gives the `skipped` ticks after `last_tick` their predicted totals. Out of line and
-    /// cold: an overrun is rare, and its loop kept inline costs the nominal step registers.
+    /// Gives the `skipped` ticks after the last update their predicted totals (ticks skipped
+    /// by an overrun). Out of line and cold: an overrun is rare, and its loop kept inline costs
+    /// the nominal step registers.
     #[cold]
     #[inline(never)]
-    fn fill_skipped(&mut self, skipped: u32) {
-        if self.accepted.is_none() {
-            // No reference: every slot already holds the total (see `resync`).
-            return;
-        }
+    pub(super) fn skip(&mut self, skipped: u32) {
         for _ in 0..skipped.min(RING as u32) {
             self.last_tick = self.last_tick.wrapping_add(1);
-            self.totals[self.last_tick as usize % RING] = self.predicted_total();
+            self.last.total = self.predicted_total();
+            self.totals[self.last_tick as usize % RING] = self.last.total;
         }
     }
 
-    /// The total of a tick without an accepted reading: the predicted one, or, without a
-    /// reference to predict from, the total (which every slot then holds, see `resync`).
-    fn unread_total(&self) -> u32 {
-        if self.accepted.is_some() {
-            self.predicted_total()
-        } else {
-            self.total_counts as u32
-        }
-    }
-
-    /// The total at `last_tick` if the drum kept the speed of the window before it: the
-    /// previous total plus the window's mean change per tick (rounded down).
+    /// The total of a tick without an accepted reading, the one after the last update's: the
+    /// last total plus the window's mean change per tick at the last accepted reading (rounded
+    /// down), so that the drum keeps that speed. Without a reference to predict from (before
+    /// the first reading, after a `resync`) the change is 0 and the total stays, which every
+    /// slot then holds.
     fn predicted_total(&self) -> u32 {
-        let previous = self.totals[self.last_tick.wrapping_sub(1) as usize % RING];
-        let then = self.totals[self.last_tick.wrapping_sub(1 + self.window) as usize % RING];
-        let per_tick = (previous.wrapping_sub(then) as i32) >> self.window_log2;
-        previous.wrapping_add(per_tick as u32)
+        let per_tick = self.last.change >> self.window_log2;
+        self.last.total.wrapping_add(per_tick as u32)
     }
 
     /// The total count after the reading `raw` of `tick`, if it is accepted.
@@ -200,6 +222,10 @@ impl Odometer {
     pub fn resync(&mut self) {
         self.accepted = None;
         self.totals = [self.total_counts as u32; RING];
+        self.last = Window {
+            total: self.total_counts as u32,
+            change: 0,
+        };
     }
 
     /// Ticks since the last accepted reading at `tick` (`None` before the first).
@@ -218,18 +244,12 @@ impl Odometer {
         self.total_counts as f32 * self.m_per_count
     }
 
-    /// Drum surface speed at the last update, m/s (pay-out positive): the total's change over
-    /// the last `speed_window_ticks` ticks × m per count / their time. 0 until the window has
-    /// the second reading's tick in it (the drum starts braked, at rest).
+    /// Drum surface speed at the last accepted reading, m/s (pay-out positive): the total's
+    /// change over the `speed_window_ticks` ticks up to it × m per count / their time, held
+    /// through the ticks without an accepted reading since. 0 until the window has the second
+    /// reading's tick in it (the drum starts braked, at rest).
     pub fn speed_mps(&self) -> f32 {
-        self.speed_at(self.totals[self.last_tick as usize % RING])
-    }
-
-    /// The speed at `last_tick`, whose total is `now`.
-    #[inline]
-    fn speed_at(&self, now: u32) -> f32 {
-        let then = self.totals[self.last_tick.wrapping_sub(self.window) as usize % RING];
-        now.wrapping_sub(then) as i32 as f32 * self.mps_per_window_count
+        self.last.change as f32 * self.mps_per_window_count
     }
 }
 
@@ -299,6 +319,39 @@ mod tests {
         assert_eq!(o.ticks_since_accepted(3), Some(2));
         o.update(3, Some(400)).unwrap();
         assert_eq!(o.total_counts(), 300);
+    }
+
+    #[test]
+    fn the_speed_holds_through_rejected_readings_and_the_total_comes_back() {
+        let mut o = odo(16);
+        let mut raw = 0_u32;
+        for t in 0..20 {
+            o.update(t, Some(raw)).unwrap();
+            raw += 100;
+        }
+        let v = o.speed_mps();
+        assert!(v > 0.0);
+        for t in 20..25 {
+            assert_eq!(o.update(t, None), Err(CountFault::Missing));
+            assert_eq!(o.speed_mps(), v, "tick {t}");
+            raw += 100;
+        }
+        assert_eq!(
+            o.update(25, Some((raw + 30_000) & 0xFFFF)),
+            Err(CountFault::Jump)
+        );
+        assert_eq!(o.speed_mps(), v);
+        raw += 100;
+        // The next good reading: the true total, and the window's speed from it (the
+        // predicted totals were exact at a constant speed).
+        o.update(26, Some(raw & 0xFFFF)).unwrap();
+        assert_eq!(o.total_counts(), i64::from(raw));
+        assert_eq!(o.speed_mps(), v);
+        for t in 27..40 {
+            raw += 100;
+            o.update(t, Some(raw & 0xFFFF)).unwrap();
+            assert_eq!(o.speed_mps(), v, "tick {t}");
+        }
     }
 
     #[test]

@@ -383,10 +383,6 @@ struct Derived {
     coulomb_per_band: f32,
     /// 1 / τ_max: duty per N m.
     per_max_torque: f32,
-    /// The stall duty as a torque, stall duty × τ_max, N m: the stall check compares the
-    /// torque with it, without working out the duty twice (2 instructions less on the stall
-    /// path, `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
-    stall_torque_nm: f32,
 }
 
 /// The inner speed loop with its brake and fault logic.
@@ -399,21 +395,32 @@ pub struct SpeedLoop {
     command: RateCommand,
     /// The command asks for motion: |rate| above the brake's rest speed.
     command_moving: bool,
+    /// The command lets the brake be free: moving, and not in safe hold (worked out with the
+    /// command: one test on the brake's engaged and releasing steps instead of two).
+    command_frees_brake: bool,
     /// The faults every step reports until the next command: [`DriveFault::CommandInvalid`]
     /// after a non-finite one, none otherwise.
     command_faults: DriveFaults,
-    /// The reference's ramp now.
+    /// The reference's ramp: with the brake free, from the reference at the command's
+    /// arrival; otherwise from rest, its `start_tick` set when the brake is free (the drum was
+    /// held until then). Worked out with the command (and again by `clear_trip`), so that the
+    /// release's step has no division and sets one field (a second ramp from rest, kept
+    /// beside this one and copied in at the release, made that step the mission's worst, 14
+    /// instructions above the next one; 7 above it this way, exact, `scripts/bench-target`
+    /// with `TSS_BENCH_EXACT=1`; `set_command` works out one ramp instead of two).
     ramp: Ramp,
-    /// The ramp from rest to the command (its `start_tick` set when the brake is free): worked
-    /// out with the command, so that the release's step has no division.
-    ramp_from_rest: Ramp,
     integral_nm: f32,
     /// A step has been taken, so the output's `tick` is the last step's tick (kept once,
     /// there: an `Option` of it beside the output cost the step a store, 2 instructions on the
     /// mission's worst path, `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
     stepped: bool,
     stall_ticks: u32,
-    saturated_ticks: u32,
+    /// Ticks of duty saturation left before [`DriveFault::DutySaturated`] is reported (the
+    /// configuration's `saturation_ticks` while unsaturated, 0 once reported): counted down,
+    /// so that a saturated step does not load the limit (3 instructions less on it than
+    /// counting up, saturating, and comparing, exact, `scripts/bench-target` with
+    /// `TSS_BENCH_EXACT=1`).
+    saturation_left_ticks: u32,
     /// The last step's output. Its `brake` is the brake's state, which the step, `trip` and
     /// `clear_trip` change in place, and its `tension_n` the tension the feed-forward uses
     /// (the last good reading, clamped into range), which `tension` keeps (a copy of each
@@ -435,7 +442,6 @@ impl SpeedLoop {
             viscous_per_radius: cfg.drum.viscous_nm_per_radps / r,
             coulomb_per_band: cfg.drum.coulomb_nm / cfg.drum.coulomb_band_mps,
             per_max_torque: 1.0 / cfg.max_torque_nm,
-            stall_torque_nm: cfg.faults.stall_duty * cfg.max_torque_nm,
         };
         Ok(Self {
             cfg,
@@ -447,13 +453,13 @@ impl SpeedLoop {
                 safe_hold: false,
             },
             command_moving: false,
+            command_frees_brake: false,
             command_faults: DriveFaults::NONE,
             ramp: Ramp::REST,
-            ramp_from_rest: Ramp::REST,
             integral_nm: 0.0,
             stepped: false,
             stall_ticks: 0,
-            saturated_ticks: 0,
+            saturation_left_ticks: cfg.faults.saturation_ticks,
             out: DriveOutput::IDLE,
         })
     }
@@ -526,9 +532,12 @@ impl SpeedLoop {
             }
         };
         self.command_moving = self.command.rate_mps.abs() > self.cfg.brake.rest_speed_mps;
-        let (now_mps, _) = self.reference_at(tick);
-        self.ramp = self.ramp_toward_command(now_mps, tick);
-        self.ramp_from_rest = self.ramp_toward_command(0.0, tick);
+        self.command_frees_brake = self.command_moving && !self.command.safe_hold;
+        let from_mps = match self.out.brake {
+            Brake::Released { .. } => self.reference_at(tick).0,
+            Brake::Engaged | Brake::Releasing { .. } | Brake::Tripped(_) => 0.0,
+        };
+        self.ramp = self.ramp_toward_command(from_mps, tick);
         if valid {
             Ok(())
         } else {
@@ -555,8 +564,10 @@ impl SpeedLoop {
             Brake::Tripped(f) => {
                 self.out.brake = Brake::Engaged;
                 self.stall_ticks = 0;
-                self.saturated_ticks = 0;
+                self.saturation_left_ticks = self.cfg.faults.saturation_ticks;
                 self.odometer.resync();
+                // The drum was held: the next release starts the ramp from rest.
+                self.ramp = self.ramp_toward_command(0.0, 0);
                 Some(f)
             }
             _ => None,
@@ -584,24 +595,37 @@ impl SpeedLoop {
         // Odometry: a reading the odometer cannot take is a fault; too long without one trips.
         // After a gap longer than the jump check bridges, the counter's change is ambiguous
         // (it may have wrapped): the reading is not used.
+        // (An overrun is told apart once: a gap of one tick is within the bridged ones.)
         let trip_ticks = self.cfg.faults.encoder_trip_ticks;
-        let reading = if gap_ticks <= trip_ticks {
+        let reading = if gap_ticks == 1 {
             input.encoder_count
         } else {
-            None
+            // The ticks the overrun skipped get their predicted totals.
+            self.odometer.skip(gap_ticks.wrapping_sub(1));
+            if gap_ticks <= trip_ticks {
+                input.encoder_count
+            } else {
+                None
+            }
         };
-        let (counted, speed_mps) = self.odometer.update_after(tick, gap_ticks, reading);
+        let (counted, speed_mps) = self.odometer.update_next(tick, reading);
         if let Err(f) = counted {
-            let fault = match f {
-                CountFault::Jump => DriveFault::EncoderJump,
-                CountFault::Missing => DriveFault::EncoderMissing,
+            let since_accepted = self.odometer.ticks_since_accepted(tick);
+            let (fault, lost) = match f {
+                // (A jump is a reading within the gap the check bridges, against an accepted
+                // one: only the ticks since that one can have run out. Telling the two apart
+                // here, every fault branch of one step 224 → 219, exact, `scripts/bench-target`
+                // with `TSS_BENCH_EXACT=1`.)
+                CountFault::Jump => (
+                    DriveFault::EncoderJump,
+                    since_accepted.is_some_and(|t| t > trip_ticks),
+                ),
+                CountFault::Missing => (
+                    DriveFault::EncoderMissing,
+                    gap_ticks > trip_ticks || since_accepted.is_some_and(|t| t > trip_ticks),
+                ),
             };
             faults.insert(fault);
-            let lost = gap_ticks > trip_ticks
-                || self
-                    .odometer
-                    .ticks_since_accepted(tick)
-                    .is_some_and(|t| t > trip_ticks);
             if lost {
                 self.trip(fault);
             }
@@ -612,9 +636,18 @@ impl SpeedLoop {
 
         // The torque: PI + feed-forward with the brake free; while it lifts, the motor takes
         // over the tension's torque, nothing else; otherwise the motor is off.
-        let (ref_mps, ref_accel_mps2, torque_nm) = match self.out.brake {
+        let limit = self.cfg.duty_limit;
+        let per_max_torque = self.derived.per_max_torque;
+        let (ref_mps, ref_accel_mps2, torque_nm, (duty, saturated)) = match self.out.brake {
             Brake::Released { rest_ticks } => {
-                let law = self.speed_law(tick, gap_ticks, speed_mps, tension_n);
+                let (ref_mps, ref_accel_mps2, torque_nm) =
+                    self.speed_law(tick, gap_ticks, speed_mps, tension_n);
+                let law = (
+                    ref_mps,
+                    ref_accel_mps2,
+                    torque_nm,
+                    saturate(torque_nm * per_max_torque, limit),
+                );
                 if rest_ticks > 0 {
                     // At rest, the brake about to engage: a large duty holding a still drum
                     // is the motor holding the tension, not a stall (and the step counts one
@@ -622,41 +655,53 @@ impl SpeedLoop {
                     // `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
                     self.stall_ticks = 0;
                     law
-                } else if self.count_stall(gap_ticks, speed_mps, law.2) {
+                } else if counted.is_err() {
+                    // No measured motion this tick (its reading rejected or missing, the speed
+                    // held): the stall is judged on measured motion, so the tick neither counts
+                    // toward a stall nor clears one, as the brake's rest count (and the fault
+                    // paths of a jump and of a stall's or rest's count are not paid in one
+                    // tick: every fault branch of one step 212 → 208, exact,
+                    // `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
+                    law
+                } else if self.count_stall(gap_ticks, speed_mps, law.3) {
                     faults.insert(DriveFault::MotorStall);
-                    (law.0, law.1, 0.0)
+                    (law.0, law.1, 0.0, (0.0, false))
                 } else {
                     law
                 }
             }
             Brake::Releasing { .. } => {
                 self.stall_ticks = 0;
-                (0.0, 0.0, self.tension_torque_nm(tension_n))
+                let torque_nm = self.tension_torque_nm(tension_n);
+                (
+                    0.0,
+                    0.0,
+                    torque_nm,
+                    saturate(torque_nm * per_max_torque, limit),
+                )
             }
             Brake::Engaged => {
                 self.stall_ticks = 0;
                 self.integral_nm = 0.0;
-                (0.0, 0.0, 0.0)
+                (0.0, 0.0, 0.0, (0.0, false))
             }
             Brake::Tripped(f) => {
                 faults.insert(f);
                 self.stall_ticks = 0;
                 self.integral_nm = 0.0;
-                (0.0, 0.0, 0.0)
+                (0.0, 0.0, 0.0, (0.0, false))
             }
         };
-        let (duty, saturated) =
-            saturate(torque_nm * self.derived.per_max_torque, self.cfg.duty_limit);
 
         // Saturation held too long (reported); the stall is `count_stall`'s.
         let f = &self.cfg.faults;
         if saturated {
-            self.saturated_ticks = self.saturated_ticks.saturating_add(gap_ticks);
-            if self.saturated_ticks >= f.saturation_ticks {
+            self.saturation_left_ticks = self.saturation_left_ticks.saturating_sub(gap_ticks);
+            if self.saturation_left_ticks == 0 {
                 faults.insert(DriveFault::DutySaturated);
             }
         } else {
-            self.saturated_ticks = 0;
+            self.saturation_left_ticks = f.saturation_ticks;
         }
 
         // (The brake and the tension are in place.)
@@ -723,11 +768,24 @@ impl SpeedLoop {
     /// otherwise; at the stall ticks it trips the drive (returns true: the step's torque is
     /// then 0). Run from the `Released` arm of the step, it needs no test of the brake's state
     /// (the other arms reset the counter), and the threshold is compared only while counting.
-    fn count_stall(&mut self, gap_ticks: u32, speed_mps: f32, torque_nm: f32) -> bool {
+    /// It takes the duty after saturation: a saturated one is large without a comparison (the
+    /// torque compared with the stall duty's before saturation: every fault branch of one step
+    /// 200 → 194, for the unsaturated stall's count at the mission's stop 187 → 192, exact,
+    /// `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
+    fn count_stall(
+        &mut self,
+        gap_ticks: u32,
+        speed_mps: f32,
+        (duty, saturated): (f32, bool),
+    ) -> bool {
         let f = &self.cfg.faults;
-        if torque_nm.abs() >= self.derived.stall_torque_nm && speed_mps.abs() <= f.stall_speed_mps {
-            // (Cannot wrap: below `stall_ticks` ≤ 2³¹ − 1, plus a gap below 2³¹; see
-            // `Odometer::update_after` for the figure.)
+        // (A saturated duty is at the limit, at or above the stall duty: validated.)
+        let large = saturated || duty.abs() >= f.stall_duty;
+        if large && speed_mps.abs() <= f.stall_speed_mps {
+            // (Cannot wrap: below `stall_ticks` ≤ 2³¹ − 1, plus a gap below 2³¹; added
+            // without saturating, as the rest count, 2 instructions less on the benchmark's
+            // worst paths, 240 → 238 and 208 → 206, `scripts/bench-target` with
+            // `TSS_BENCH_EXACT=1`.)
             self.stall_ticks = self.stall_ticks.wrapping_add(gap_ticks);
             if self.stall_ticks >= f.stall_ticks {
                 // `trip` without its test of the brake (free here) and without its write of
@@ -774,9 +832,17 @@ impl SpeedLoop {
                 }
                 faults.insert(DriveFault::TensionOutOfRange);
             }
-            Some(t) if t >= lo => self.out.tension_n = t,
+            Some(t) if t >= lo => {
+                // (Returned as well as kept: the nominal step 1 instruction shorter than
+                // reading it back, mission mean 158.6 → 157.6, exact.)
+                self.out.tension_n = t;
+                return t;
+            }
             Some(t) => {
-                if t > f32::NEG_INFINITY {
+                // (Below `lo` or NaN: finite and not NaN if at or above the lowest finite
+                // value; one branch, where `t > −∞` took two and a jump, the slack reading's
+                // step 186 → 184, exact.)
+                if t >= f32::MIN {
                     self.out.tension_n = lo;
                 }
                 faults.insert(DriveFault::TensionOutOfRange);
@@ -792,12 +858,12 @@ impl SpeedLoop {
     /// Entering `Released` starts the ramp from rest at `tick` (the drum was held until now).
     /// At rest means the command and the measured speed ~0.
     fn advance_brake(&mut self, tick: u32, gap_ticks: u32, speed_mps: f32, counted: bool) {
-        let hold = self.command.safe_hold;
+        let frees = self.command_frees_brake;
         let target_moving = self.command_moving;
         let next = match self.out.brake {
             Brake::Tripped(_) => return,
             Brake::Engaged => {
-                if target_moving && !hold && counted {
+                if frees && counted {
                     Brake::Releasing {
                         ticks_left: self.cfg.brake.release_ticks,
                     }
@@ -806,13 +872,11 @@ impl SpeedLoop {
                 }
             }
             Brake::Releasing { ticks_left } => {
-                if !target_moving || hold {
+                if !frees {
                     Brake::Engaged
                 } else if ticks_left <= gap_ticks {
-                    self.ramp = Ramp {
-                        start_tick: tick,
-                        ..self.ramp_from_rest
-                    };
+                    // (The ramp is from rest: the brake was not free at the command.)
+                    self.ramp.start_tick = tick;
                     Brake::Released { rest_ticks: 0 }
                 } else {
                     Brake::Releasing {
@@ -821,6 +885,11 @@ impl SpeedLoop {
                 }
             }
             Brake::Released { ref mut rest_ticks } => {
+                if !counted {
+                    // No measured motion (the speed held): the rest count neither advances
+                    // nor restarts, as the stall's (see the step).
+                    return;
+                }
                 // At rest: the command is rest and the drum is at rest (its reference, which
                 // it follows, is on its way there; waiting for it as well made the step's
                 // worst path 5 instructions longer, `examples/bench_speed_loop.rs`).
@@ -893,16 +962,29 @@ impl SpeedLoop {
 /// fails both comparisons of the in-range test, so a value inside the limits takes two
 /// comparisons and no NaN test (6 instructions less on the step's unsaturated path than
 /// testing for NaN after the two bounds, `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
+/// The lower bound first: a saturation either way takes two comparisons too (the upper bound
+/// first, one above and three below: every fault branch of one step 208 → 206, exact).
 fn saturate(x: f32, limit: f32) -> (f32, bool) {
-    if x > limit {
-        (limit, true)
-    } else if x >= -limit {
-        (x, false)
+    if x >= -limit {
+        if x > limit {
+            (limit, true)
+        } else {
+            (x, false)
+        }
     } else if x < -limit {
         (-limit, true)
     } else {
-        (0.0, false)
+        nan_duty()
     }
+}
+
+/// [`saturate`]'s NaN: no torque. Cold and out of line, so that the saturation's branches
+/// stay branches (if-converted by LLVM, they cost every step 11 instructions more, exact,
+/// `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
+#[cold]
+#[inline(never)]
+fn nan_duty() -> (f32, bool) {
+    (0.0, false)
 }
 
 /// [`saturate`]'s value.
@@ -952,7 +1034,9 @@ mod tests {
         assert_eq!(s.reference_at(500), (0.5, 1.0));
         assert_eq!(s.reference_at(1000), (1.0, 0.0));
         assert_eq!(s.reference_at(5000), (1.0, 0.0));
-        // An acceleration pointing away from the command does not move the reference away.
+        // With the brake free, the next command ramps from the reference; an acceleration
+        // pointing away from the command does not move the reference away.
+        s.out.brake = Brake::Released { rest_ticks: 0 };
         s.set_command(
             RateCommand {
                 rate_mps: 0.5,
@@ -964,6 +1048,83 @@ mod tests {
         .unwrap();
         let (v, a) = s.reference_at(1500);
         assert!((v - 0.75).abs() < 1e-6 && a == -0.5, "{v} {a}");
+    }
+
+    #[test]
+    fn the_ramp_starts_from_rest_at_every_release() {
+        let mut s = SpeedLoop::new(DriveConfig::example()).unwrap();
+        let input = |tick| DriveInput {
+            tick,
+            encoder_count: Some(0),
+            tension_n: Some(20.0),
+        };
+        // 1 m/s at 1 m/s², commanded while the brake is on: the ramp starts at the release.
+        s.set_command(
+            RateCommand {
+                rate_mps: 1.0,
+                accel_mps2: 1.0,
+                safe_hold: false,
+            },
+            0,
+        )
+        .unwrap();
+        let mut tick = 0;
+        while !matches!(s.step(&input(tick)).brake, Brake::Released { .. }) {
+            tick += 1;
+        }
+        let released = tick;
+        assert!(released > 0);
+        assert_eq!(s.output().ref_rate_mps, 0.0);
+        for t in released + 1..=released + 500 {
+            s.step(&input(t));
+        }
+        assert!((s.output().ref_rate_mps - 0.5).abs() < 1e-6);
+        // Tripped mid-ramp and cleared, under the same command: the drum was held, so the
+        // next release starts the ramp from rest again (not from where it stood).
+        s.trip(DriveFault::Actuator);
+        s.clear_trip();
+        let mut tick = released + 501;
+        while !matches!(s.step(&input(tick)).brake, Brake::Released { .. }) {
+            tick += 1;
+        }
+        assert_eq!(s.output().ref_rate_mps, 0.0);
+        for t in tick + 1..=tick + 100 {
+            s.step(&input(t));
+        }
+        assert!((s.output().ref_rate_mps - 0.1).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_tick_without_a_measured_speed_neither_counts_toward_a_stall_nor_clears_it() {
+        let mut s = SpeedLoop::new(DriveConfig::example()).unwrap();
+        s.set_command(
+            RateCommand {
+                rate_mps: 1.0,
+                accel_mps2: 0.0,
+                safe_hold: false,
+            },
+            0,
+        )
+        .unwrap();
+        // A still drum under the largest tension: the duty saturates, a stall is counted.
+        let input = |tick, encoder_count| DriveInput {
+            tick,
+            encoder_count,
+            tension_n: Some(200.0),
+        };
+        let mut tick = 0;
+        while !matches!(s.step(&input(tick, Some(0))).brake, Brake::Released { .. }) {
+            tick += 1;
+        }
+        let counted = s.stall_ticks;
+        assert!(counted > 0);
+        tick += 1;
+        let out = *s.step(&input(tick, None));
+        assert!(out.faults.contains(DriveFault::EncoderMissing));
+        assert_eq!(s.stall_ticks, counted);
+        tick += 1;
+        s.step(&input(tick, Some(0)));
+        assert_eq!(s.stall_ticks, counted + 1);
     }
 
     #[test]
