@@ -141,20 +141,158 @@ fn libration_periods_are_those_of_the_dumbbell() {
 }
 
 /// Verification 1: the bounce (longitudinal) period of a massless tether is
-/// 2π√(l·m_r/EA) within 1 %. Started unstretched, the tether bounces about its static stretch.
+/// 2π√(l·m_r/EA) within 1 %. Started in static equilibrium with the sub-satellite moving away
+/// at 5 mm/s (the reel locked), the tether bounces about its static stretch: the mean range is
+/// the initial one.
 #[test]
 fn bounce_period_is_that_of_the_spring_and_reduced_mass() {
     let (l, ea): (f64, f64) = (1_000.0, 1e4);
     let m_r = 10_000.0 * 100.0 / 10_100.0;
     let expect = 2.0 * std::f64::consts::PI * (l * m_r / ea).sqrt();
-    let mut p = ElasticPlant::new(params(ea), at_rest(l)).unwrap();
+    let init = InitialConditions {
+        rate_mps: 5e-3,
+        ..at_rest(l)
+    };
+    let mut p = ElasticPlant::new(params(ea), init).unwrap();
+    let range0 = p.measure().range_m;
     let s = sample(&mut p, 10.0 * expect, 0.1, |p| p.measure().range_m);
     let mean = s.iter().map(|x| x.1).sum::<f64>() / s.len() as f64;
     let centred: Vec<_> = s.iter().map(|&(t, r)| (t, r - mean)).collect();
     let got = period_s(&centred);
     let err = (got - expect).abs() / expect;
-    println!("bounce: {got:.4} s vs {expect:.4} s ({err:.2e})");
+    let amplitude = 5e-3 * expect / (2.0 * std::f64::consts::PI);
+    println!(
+        "bounce: {got:.4} s vs {expect:.4} s ({err:.2e}); mean range − initial {:.2e} m (amplitude {amplitude:.4} m)",
+        mean - range0
+    );
     assert!(err < 1e-2, "{got} vs {expect}");
+    assert!(
+        (mean - range0).abs() < 0.05 * amplitude,
+        "{mean} vs {range0}"
+    );
+}
+
+/// The initial state is static equilibrium: a radial tether with beads (ρ = 0.2 kg/m, 100-m
+/// segments, 1 km), the reel locked, starts with every segment stretched to its share of the
+/// gravity-gradient tension, so nothing moves along it. Over 20 bounce periods the tension at
+/// both ends stays within 1e-4 of its initial value (started unstretched, it swung between 0
+/// and twice the static tension).
+#[test]
+fn the_initial_state_is_static() {
+    let mut prm = params(1e4);
+    prm.tether.density_kg_per_m = 0.2;
+    prm.tether.segment_length_m = 100.0;
+    prm.tether.damping_ns = 50.0;
+    let mut p = ElasticPlant::new(prm, at_rest(1_000.0)).unwrap();
+    assert_eq!(p.measure().beads, 9);
+    let m0 = p.measure();
+    let (reel0, tip0) = (m0.tension_reel_n, m0.tension_tip_n);
+    // The gravity-gradient tension: 3n²·(Σ over the outer masses of m·x), positive at both ends.
+    assert!(reel0 > tip0 && tip0 > 0.0, "{reel0} {tip0}");
+    let bounce = 2.0 * std::f64::consts::PI * (1_000.0 * 99.0 / 1e4f64).sqrt();
+    let mut worst: f64 = 0.0;
+    for _ in 0..(20.0 * bounce / 0.5) as usize {
+        p.step(0.0, 0.5).unwrap();
+        let m = p.measure();
+        worst = worst
+            .max((m.tension_reel_n - reel0).abs() / reel0)
+            .max((m.tension_tip_n - tip0).abs() / tip0);
+    }
+    println!(
+        "static start: T_reel {reel0:.6} N, T_tip {tip0:.6} N, worst relative change {worst:.2e}"
+    );
+    assert!(worst < 1e-4, "{worst}");
+}
+
+/// The initial tension is Eq. 5a's at l̈ = 0 (docs/equations.md §2):
+/// T = m_r l [(θ̇+α̇)² cos²β + β̇² + (μ/R³)(3cos²α cos²β − 1)], on a librating, paying-out
+/// 100-m tether (massless, so μ1 = 0 and μ2 = 1), within 1e-4 (the exact field's (l/R) terms).
+#[test]
+fn the_initial_tension_is_that_of_eq_5a() {
+    let mut prm = params(1e4);
+    prm.reel.locked = false;
+    let init = InitialConditions {
+        rate_mps: 0.1,
+        alpha_rad: -0.61,
+        alpha_rate_radps: 2e-4,
+        beta_rad: 0.1,
+        beta_rate_radps: -1e-4,
+        ..at_rest(100.0)
+    };
+    let p = ElasticPlant::new(prm, init).unwrap();
+    let m = p.measure();
+    let n2 = tss_reel::orbit::EARTH_MU_M3PS2 / RADIUS_M.powi(3);
+    let m_r = 10_000.0 * 100.0 / 10_100.0;
+    let (ca, cb) = (init.alpha_rad.cos(), init.beta_rad.cos());
+    let expect = m_r
+        * m.range_m
+        * ((m.orbit_rate_radps + init.alpha_rate_radps).powi(2) * cb * cb
+            + init.beta_rate_radps.powi(2)
+            + n2 * (3.0 * ca * ca * cb * cb - 1.0));
+    let err = (m.tension_reel_n - expect).abs() / expect;
+    println!(
+        "initial tension {:.6e} N vs Eq. 5a {expect:.6e} N ({err:.1e})",
+        m.tension_reel_n
+    );
+    assert!(err < 1e-4, "{} vs {expect}", m.tension_reel_n);
+}
+
+/// The feeding rule on a flown tether: paying out steadily at 0.5 m/s from 150 m
+/// (ρ = 0.01 kg/m, 20-m segments, an ideal reel, started in equilibrium), each inserted bead
+/// takes the material's velocity, so the tension at the reel never dips at an insertion (a
+/// step no larger than twice the largest step between insertions) and the tether stays taut
+/// (interpolated, the bead lagged the tether by l̇/2 and the reel segment's damper,
+/// −C·l̇/(2L_s) = −0.6 N, slackened a tether of 0.05 N); the mass is booked exactly through the
+/// insertions and the removals of the wind-in after. (Faster or heavier, ½ρl̇² — the momentum
+/// the paid-out tether takes from node 1 — exceeds the gravity-gradient tension and the tether
+/// goes slack whatever the feeding rule does.)
+#[test]
+fn beads_enter_and_leave_without_a_tension_dip() {
+    let mut prm = params(1e4);
+    prm.tether.density_kg_per_m = 0.01;
+    prm.tether.segment_length_m = 20.0;
+    prm.tether.damping_ns = 50.0;
+    prm.reel.locked = false;
+    prm.reel.model = ReelModel::Ideal;
+    let rate = 0.5;
+    let init = InitialConditions {
+        rate_mps: rate,
+        ..at_rest(150.0)
+    };
+    let mut p = ElasticPlant::new(prm, init).unwrap();
+    let total0: f64 = p.masses().iter().sum();
+    let dt = 0.25;
+    let mut tension = p.measure().tension_reel_n;
+    let (mut at_insertion, mut between): (f64, f64) = (0.0, 0.0);
+    let mut least = tension;
+    for _ in 0..(300.0 / dt) as usize {
+        let inserted = p.feeds().inserted;
+        p.step(rate, dt).unwrap();
+        let now = p.measure().tension_reel_n;
+        let step = (now - tension).abs();
+        if p.feeds().inserted > inserted {
+            at_insertion = at_insertion.max(step);
+        } else {
+            between = between.max(step);
+        }
+        least = least.min(now);
+        tension = now;
+    }
+    let inserted = p.feeds().inserted;
+    for _ in 0..(300.0 / dt) as usize {
+        p.step(-rate, dt).unwrap();
+    }
+    let total: f64 = p.masses().iter().sum();
+    println!(
+        "{inserted} insertions, {} removals: tension step at an insertion ≤ {at_insertion:.3e} N, \
+         between ≤ {between:.3e} N, least tension {least:.4} N; mass change {:.1e}",
+        p.feeds().removed,
+        (total - total0) / total0
+    );
+    assert!(inserted >= 5 && p.feeds().removed >= 5, "{:?}", p.feeds());
+    assert!(least > 0.0, "slack at {least} N");
+    assert!(at_insertion <= 2.0 * between, "{at_insertion} vs {between}");
+    assert!(((total - total0) / total0).abs() < 1e-14);
 }
 
 /// Verification 2: with drag, J2 and damping off, the reel locked, on a circular orbit, the
@@ -170,6 +308,9 @@ fn jacobi_integral_is_conserved_over_ten_orbits() {
             alpha_rad: 0.2,
             beta_rad: 0.1,
             alpha_rate_radps: 1e-4,
+            // The locked reel holds the tether the sub-satellite leaves at 0.2 m/s: the beads
+            // bounce and bow (the equilibrium start alone stays straight).
+            rate_mps: 0.2,
             ..at_rest(5_000.0)
         },
     )
@@ -678,7 +819,8 @@ fn drag_lowers_the_orbit() {
     assert!((1.0..10.0).contains(&lost), "{lost}");
 }
 
-/// Sensing: the exit direction and the line agree on a straight tether and part when it bows.
+/// Sensing: the exit direction and the line agree on a straight tether and part when it bows
+/// (the locked reel holding a tether whose far end leaves at 0.5 m/s: bounce and Coriolis).
 #[test]
 fn exit_direction_and_line_part_when_the_tether_bows() {
     let mut prm = params(1_000.0);
@@ -687,6 +829,7 @@ fn exit_direction_and_line_part_when_the_tether_bows() {
         prm,
         InitialConditions {
             alpha_rate_radps: 5e-4,
+            rate_mps: 0.5,
             ..at_rest(5_000.0)
         },
     )

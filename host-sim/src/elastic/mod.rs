@@ -33,6 +33,7 @@
 //! drum's stick/slip switches happen between substeps.
 
 pub mod environment;
+mod initial;
 pub mod reel_drum;
 pub mod tether;
 
@@ -144,7 +145,8 @@ pub struct ElasticParams {
     pub courant: f64,
 }
 
-/// The initial state, in the rigid plant's terms: straight, at its initial length, unstretched.
+/// The initial state, in the rigid plant's terms: straight, at its initial length, each segment
+/// stretched to the tension that motion needs (static equilibrium, `initial.rs`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct InitialConditions {
     /// Paid-out length l(0), m.
@@ -433,6 +435,26 @@ enum ReelDrive {
     },
 }
 
+impl ReelDrive {
+    /// The reel's rate l̇ with the drum turning at `drum_speed_radps`, m/s.
+    fn rate_mps(&self, drum_speed_radps: f64) -> f64 {
+        match *self {
+            ReelDrive::Rate(v) => v,
+            ReelDrive::Drum {
+                motion: Motion::Stuck,
+                ..
+            }
+            | ReelDrive::Held {
+                motion: Motion::Stuck,
+                ..
+            } => 0.0,
+            ReelDrive::Drum { drum, .. } | ReelDrive::Held { drum, .. } => {
+                drum.radius_m * drum_speed_radps
+            }
+        }
+    }
+}
+
 /// The drum motor's torque and its speed loop's integrator rate: the speed loop's
 /// ([`DrumParams::speed_loop`]) under a rate command; under a tension command T (a tension law,
 /// `crate::laws`) the motor holds the tether back with −T·r (T ≥ 0: a tether only pulls) and
@@ -601,8 +623,9 @@ pub struct ElasticPlant {
 }
 
 impl ElasticPlant {
-    /// A tether straight along (α, β) at its initial length, unstretched, with the centre of
-    /// mass on the orbit (see the module doc), the reel running at the initial rate.
+    /// A tether straight along (α, β) at its initial length, pre-stretched to static
+    /// equilibrium (`initial.rs`), with the centre of mass on the orbit (see the module doc),
+    /// the reel running at the initial rate.
     pub fn new(p: ElasticParams, init: InitialConditions) -> Result<Self, ElasticError> {
         p.validate()?;
         check(
@@ -634,10 +657,8 @@ impl ElasticPlant {
         let e_t = (e_r * ca + e_th * sa) * cb + e_h * sb;
         let e_t_rate = (e_th * ca - e_r * sa) * (init.alpha_rate_radps * cb)
             + ((e_r * ca + e_th * sa) * (-sb) + e_h * cb) * init.beta_rate_radps;
-        let omega = e_h * theta_rate;
 
         let layout = Layout::initial(&p.tether, init.length_m);
-        let lr = layout.reel_segment_m(&p.tether, init.length_m);
         let mut masses = Vec::new();
         let b = &p.bodies;
         layout.masses(
@@ -647,29 +668,25 @@ impl ElasticPlant {
             init.length_m,
             &mut masses,
         );
-        let total: f64 = masses.iter().sum();
-        let (mut pos, mut vel) = (Vec::new(), Vec::new());
-        for i in 0..layout.nodes() {
-            let s = if i == 0 {
-                0.0
-            } else {
-                lr + (i - 1) as f64 * p.tether.segment_length_m
-            };
-            let q = e_t * s;
-            // The paid-out tether moves out with the sub-satellite at l̇ (no strain change).
-            let along = if i == 0 { 0.0 } else { init.rate_mps };
-            pos.push(q);
-            vel.push(e_t * along + e_t_rate * s + omega.cross(&q));
-        }
-        let mean = |v: &[Vec3]| -> Vec3 {
-            v.iter().zip(&masses).map(|(v, m)| v * *m).sum::<Vec3>() / total
-        };
-        let (pc, vc) = (mean(&pos), mean(&vel));
-        pos.iter_mut().for_each(|q| *q -= pc);
-        vel.iter_mut().for_each(|w| *w -= vc);
-
         let locked = p.reel.locked;
         let rate = if locked { 0.0 } else { init.rate_mps };
+        let start = initial::equilibrium(
+            &p.tether,
+            &p.environment,
+            &layout,
+            &masses,
+            init.length_m,
+            init.rate_mps,
+            rate,
+            &r_c,
+            &initial::Line {
+                direction: e_t,
+                direction_rate: e_t_rate,
+                frame_rate: e_h * theta_rate,
+            },
+        );
+        let (pos, vel) = (start.pos, start.vel);
+
         let (mut speed, mut integral) = (0.0, 0.0);
         let mut reel = match p.reel.model {
             _ if locked => ReelState::Locked,
@@ -680,11 +697,12 @@ impl ElasticPlant {
             }
             ReelModel::Motor(drum) => {
                 speed = rate / drum.radius_m;
-                // The loop starts holding that speed against the friction (no tension yet).
+                // The loop starts holding that speed against the friction and the tension.
                 let motion = if speed == 0.0 {
                     Motion::Stuck
                 } else {
-                    let hold = drum.viscous_nms * speed + drum.coulomb_nm * speed.signum();
+                    let hold = drum.viscous_nms * speed + drum.coulomb_nm * speed.signum()
+                        - drum.radius_m * start.reel_tension_n;
                     integral = hold / drum.ki();
                     Motion::Slipping(speed.signum())
                 };
@@ -1239,7 +1257,10 @@ impl ElasticPlant {
             self.set_motion(motion);
             self.y.drum_speed_radps = speed;
         }
-        self.feed();
+        let rate = self
+            .drive(command, t0 + h, brake)
+            .rate_mps(self.y.drum_speed_radps);
+        self.feed(rate);
     }
 
     /// τ_m + r T_reel at the current state, N·m.
@@ -1277,7 +1298,8 @@ impl ElasticPlant {
     }
 
     /// Applies the feeding rule until the reel segment is inside its band.
-    fn feed(&mut self) {
+    /// The reel pays out at `reel_rate_mps` (the material's rate at the reel).
+    fn feed(&mut self, reel_rate_mps: f64) {
         let mut m = std::mem::take(&mut self.ws.masses);
         loop {
             self.node_masses(&mut m);
@@ -1285,6 +1307,7 @@ impl ElasticPlant {
                 &self.p.tether,
                 &mut self.layout,
                 self.y.paid_out_m,
+                reel_rate_mps,
                 &m,
                 &mut self.y.pos,
                 &mut self.y.vel,
@@ -1314,20 +1337,7 @@ fn derivative(
     let n = masses.len();
     dy.pos.resize(n, Vec3::zeros());
     dy.vel.resize(n, Vec3::zeros());
-    let reel_rate = match drive {
-        ReelDrive::Rate(v) => v,
-        ReelDrive::Drum {
-            motion: Motion::Stuck,
-            ..
-        }
-        | ReelDrive::Held {
-            motion: Motion::Stuck,
-            ..
-        } => 0.0,
-        ReelDrive::Drum { drum, .. } | ReelDrive::Held { drum, .. } => {
-            drum.radius_m * y.drum_speed_radps
-        }
-    };
+    let reel_rate = drive.rate_mps(y.drum_speed_radps);
     dy.r_ref = y.v_ref;
     let g_ref = env.gravity(&y.r_ref);
     dy.v_ref = g_ref;
