@@ -66,10 +66,9 @@ mod bench {
     /// own count is taken from a build without the parts (see the crate docs).
     pub const TIME_PARTS: bool = matches!(option_env!("TSS_BENCH_PARTS"), Some(v) if !v.is_empty());
 
-    /// The instruction budget of one step, checked against the worst case: 500 (issue 7),
-    /// then 550 for a readable controller (issue 15), then 800 for the whole flight step with
-    /// the estimator (issue 18).
-    pub const BUDGET_INSTRUCTIONS: u32 = 800;
+    /// The ceiling of one outer step's instructions, checked against the worst case
+    /// (`scripts/bench-target` states it with the inner step's).
+    pub const CEILING_INSTRUCTIONS: u32 = 1000;
 
     /// Mean and worst of one phase's steps.
     #[derive(Clone, Copy)]
@@ -372,7 +371,7 @@ mod bench {
     fn report_steps(name: &str, r: &Run) {
         let s = &r.step;
         defmt::info!(
-            "{=str}: step instructions over {=u32} steps: median {=u32}, p99 {=u32}, worst {=u32} (tick {=u32}), mean {=u32}; budget {=u32}: {=str}",
+            "{=str}: step instructions over {=u32} steps: median {=u32}, p99 {=u32}, worst {=u32} (tick {=u32}), mean {=u32}; ceiling {=u32}: {=str}",
             name,
             s.n,
             s.median(),
@@ -380,8 +379,8 @@ mod bench {
             s.max.0,
             s.max.1,
             s.mean(),
-            BUDGET_INSTRUCTIONS,
-            if s.max.0 <= BUDGET_INSTRUCTIONS { "met" } else { "NOT MET" }
+            CEILING_INSTRUCTIONS,
+            if s.max.0 <= CEILING_INSTRUCTIONS { "holds" } else { "EXCEEDED" }
         );
         defmt::info!(
             "{=str}: health Nominal {=u32}, Degraded {=u32}, SafeHold {=u32} steps",

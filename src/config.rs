@@ -4,7 +4,6 @@
 //! by [`crate::controller::Controller::new`]): a controller that exists is a valid one. Errors
 //! are typed and name the parameter (its path in [`Config`]) and the value.
 
-use crate::controller::ProtectionConfig;
 use crate::envelope::Envelope;
 use crate::estimator;
 use crate::law::Gains;
@@ -367,8 +366,8 @@ impl<T: Real> Config<T> {
 /// Shortest control period, s (1 kHz). The law's Eq. 27 and blend are written for a period
 /// far below its time constants (see [`MAX_POLE_PERIOD_PRODUCT`]), so there is no lower limit
 /// from the law; this one keeps the u32 tick count from wrapping in less than 49 days (the
-/// controller handles a wrap, see [`crate::controller`]) and the step (≈ 550 Cortex-M4
-/// instructions) a small share of the period.
+/// controller handles a wrap, see [`crate::controller`]) and the step a small share of the
+/// period.
 pub const MIN_PERIOD_S: f64 = 1e-3;
 
 /// Largest |s|·Δt of a rate the controller must represent at its period Δt: the fastest Eq. 28
@@ -431,6 +430,77 @@ fn estimator_path(param: &'static str) -> &'static str {
         _ => "rate_source.estimator",
     }
 }
+
+/// The protection's parameters (`Config::protection`; `None` there: the paper's controller,
+/// no protection).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProtectionConfig<T> {
+    /// T_min, the least tension the command keeps at the reel, N (≥ 0).
+    pub min_tension_n: T,
+    /// T_max, the most tension the command allows at the reel, N (> T_min).
+    pub max_tension_n: T,
+    /// τ_f, the time constant over which the load cell corrects the free-tension model, s
+    /// (at least the control period).
+    pub tension_filter_s: T,
+    /// τ, the reel drive's first-order lag, s (0: the drive follows the command).
+    pub drive_lag_s: T,
+    /// The resolution of the encoder's measured mean rate, m/s: one count per period
+    /// (2πr/N/Δt). A measured rate within it of the drive model's mean rate is the count's
+    /// rounding, not the drive's motion, and does not correct the model; beyond it the model is
+    /// corrected by the excess only. 0: every measured rate is taken as it is; a resolution
+    /// larger than any rate leaves the drive to the model alone (no upper bound is needed).
+    pub rate_resolution_mps: T,
+}
+
+impl<T: Real> ProtectionConfig<T> {
+    /// Defaults for a real reel: T_min = 2 mN (docs/equations.md §14: 10 mN winds the paper's
+    /// release back to docking, 5 mN deploys), T_max = 50 N (4× the mission's nominal peak),
+    /// τ_f = 3600 s (a load cell of σ = 0.1 N then corrects the model to 1.2 mN), no drive lag.
+    pub fn default_for_period() -> Self {
+        Self {
+            min_tension_n: T::from_f64(2e-3),
+            max_tension_n: T::from_f64(50.0),
+            tension_filter_s: T::from_f64(3600.0),
+            drive_lag_s: T::ZERO,
+            rate_resolution_mps: T::ZERO,
+        }
+    }
+
+    /// Checks the parameters against the control period `period_s`.
+    pub fn validate(&self, period_s: T) -> Result<(), ConfigError> {
+        at_least("protection.min_tension_n", self.min_tension_n, T::ZERO)?;
+        above(
+            "protection.max_tension_n",
+            self.max_tension_n,
+            self.min_tension_n,
+        )?;
+        positive("protection.tension_filter_s", self.tension_filter_s)?;
+        if self.tension_filter_s < period_s {
+            return Err(ConfigError::new(
+                "protection.tension_filter_s",
+                self.tension_filter_s,
+                Rule::BelowMinimum,
+            ));
+        }
+        at_least("protection.drive_lag_s", self.drive_lag_s, T::ZERO)?;
+        at_least(
+            "protection.rate_resolution_mps",
+            self.rate_resolution_mps,
+            T::ZERO,
+        )?;
+        if self.max_tension_n > T::from_f64(MAX_PLAUSIBLE_TENSION_N) {
+            return Err(ConfigError::new(
+                "protection.max_tension_n",
+                self.max_tension_n,
+                Rule::TooLarge,
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A tension reading beyond ± this is a sensor fault, not a tether (N): it is not used.
+pub const MAX_PLAUSIBLE_TENSION_N: f64 = 1e5;
 
 pub(crate) fn finite<T: Real>(param: &'static str, v: T) -> Result<(), ConfigError> {
     if v.is_finite() {

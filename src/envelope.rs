@@ -18,13 +18,12 @@
 //! is measured to the limit less a guard of [`LENGTH_GUARD_REL`] × the limit, which covers the
 //! f32 rounding of the sensed length.
 //!
-//! With the controller's protection (`crate::controller::ProtectionConfig`, docs/equations.md
+//! With the controller's protection ([`crate::config::ProtectionConfig`], docs/equations.md
 //! §14) two more bounds enter: the tension bound, a window of commands inside the acceleration
 //! window (the acceleration limit wins where they disagree), and the drive's overrun: a drive
 //! with lag τ runs τ|v| beyond the commands before it stops, so the distance to a length limit
 //! is measured less that overrun, which makes the staircase exact for the drive.
 
-use crate::controller::protection::Bounds;
 use crate::real::Real;
 
 /// Guard kept from each length limit, relative to the limit (≈ one f32 ulp: 3.6 mm at 30 km),
@@ -79,6 +78,37 @@ impl Saturation {
     /// Some limit acted.
     pub fn any(self) -> bool {
         self.0 != 0
+    }
+}
+
+/// What the envelope needs from the protection at one step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Bounds<T> {
+    /// The commands the tether carries, [lowest, highest], m/s, from the tension bound (None:
+    /// no tension sample, or no protection). The envelope keeps its acceleration limit over it.
+    pub(crate) tension_rate_mps: Option<(T, T)>,
+    /// The commanded acceleration the tether carries, [lowest, highest], m/s² (the bound on
+    /// Eq. 30's reported value; the drive's acceleration itself when it follows the command).
+    pub(crate) tension_accel_mps2: Option<(T, T)>,
+    /// How far the drive runs toward the spool end beyond the commands, m (τ·max(v, 0)).
+    pub(crate) overrun_out_m: T,
+    /// How far the drive runs toward docking beyond the commands, m (τ·max(−v, 0)).
+    pub(crate) overrun_in_m: T,
+    /// The share of the acceleration limit the braking staircase toward a length limit uses:
+    /// (1 − e^{−h})/h with a lag (the drive's peak acceleration is then the limit), else 1.
+    pub(crate) braking_fraction: T,
+}
+
+impl<T: Real> Bounds<T> {
+    /// Nothing beyond the envelope (no protection configured).
+    pub(crate) fn none() -> Self {
+        Self {
+            tension_rate_mps: None,
+            tension_accel_mps2: None,
+            overrun_out_m: T::ZERO,
+            overrun_in_m: T::ZERO,
+            braking_fraction: T::ONE,
+        }
     }
 }
 
@@ -151,13 +181,12 @@ impl<T: Real> PreparedEnvelope<T> {
     /// [`Envelope::limit`] for a request that is not NaN: the controller's (the law's
     /// solution is checked finite, a safe action asks for the previous command or zero), so the
     /// step does not test it again.
-    // Inlined into the step: 13 instructions less on a nominal step
-    // (tools/trace_profile.py, replay tick 301: 664 → 651).
-    #[inline(always)]
     ///
     /// `bounds` are the protection's: the tension window (inside the acceleration window: the
     /// acceleration limit wins) and the drive's overrun, by which the room to each length limit
     /// is shortened.
+    // Inlined, as `limit_law`.
+    #[inline(always)]
     pub(crate) fn limit_request(
         &self,
         requested_mps: T,
@@ -232,8 +261,8 @@ impl<T: Real> PreparedEnvelope<T> {
     /// The law's request limited ([`Self::limit_request`]) and the acceleration reported with
     /// it ([`Self::commanded_accel`]): the command, its acceleration, and every limit that acted
     /// on either.
-    // Inlined into its caller, which calls it once per kind of `bounds` (the controller: none,
-    // or the protection's), so that constant bounds cost nothing.
+    // Inlined into the step with constant bounds when there is no protection (the flight
+    // configuration): out of line the outer step exceeded its ceiling (scripts/bench-target).
     #[inline(always)]
     pub(crate) fn limit_law(
         &self,
@@ -256,6 +285,7 @@ impl<T: Real> PreparedEnvelope<T> {
     /// the law's rate jumps, a blend restart from a held rate) by the acceleration limit and by
     /// the tension bound (the acceleration limit wins). With an ideal reel it is the l̈ of
     /// Eq. 5a's tension (the paper's Fig. 4).
+    // Inlined, as `limit_law`.
     #[inline(always)]
     pub(crate) fn commanded_accel(
         &self,

@@ -66,7 +66,6 @@ const _: () = assert!(FAST_RANGE * STEPS_PER_RAD < 511.0 && K_ROUNDER == 8_388_6
 const ROUNDER: f32 = 12_582_912.0;
 
 /// `v` rounded to the nearest integer, ties to even, for |v| < 2²² (the callers guarantee it).
-#[inline(always)]
 fn round_small(v: f32) -> f32 {
     (v + ROUNDER) - ROUNDER
 }
@@ -199,9 +198,8 @@ pub fn exp2_and_complement(t: f32) -> (f32, f32) {
 /// [`exp2_and_complement`] outside its fast range: NaN gives NaN; below −150, (0, 1); from
 /// −150 to −126, where 2^t is subnormal, 2^{t+64}·2⁻⁶⁴ (t + 64 is exact, the scaling rounds
 /// once) with the complement 1; from +0 up, the same kernel with 2^k up to 2¹²⁷ (2¹²⁸ as
-/// 2·2¹²⁷), overflowing to +∞ at 128. Out of line: the blend's argument is never here, and
-/// it keeps libm's `exp2f` and `expm1f` out of the firmware.
-#[inline(never)]
+/// 2·2¹²⁷), overflowing to +∞ at 128. Without libm: it keeps libm's `exp2f` and `expm1f`
+/// out of the firmware.
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(t >= …)` is meant: it is true for NaN.
 fn exp2_special(t: f32) -> (f32, f32) {
     const TWO_TO_MINUS_64: f32 = 1.0 / 18_446_744_073_709_551_616.0;
@@ -226,7 +224,6 @@ fn exp2_special(t: f32) -> (f32, f32) {
 
 /// (2^k e^r, 1 − 2^k e^r) for an integer −126 ≤ k ≤ 0 and |r| ≤ ln 2 / 2 (plus rounding): the
 /// shared end of [`exp_and_complement`] and [`exp2_and_complement`].
-#[inline(always)]
 fn two_to_k_times_exp(k: f32, r: f32) -> (f32, f32) {
     // q = e^r − 1, |q| < 0.42.
     let q = r + r * r * (E0 + r * (E1 + r * (E2 + r * (E3 + r * (E4 + r * E5)))));

@@ -1,4 +1,4 @@
-//! Proofs of the libration estimator (`src/estimator.rs`, issue 18): the filter on α samples
+//! Proofs of the libration estimator (`src/estimator/`, issue 18): the filter on α samples
 //! alone, driven by the reel, against the simulator's rigid plant (`tss_sim::plant::RigidModel`,
 //! Eq. 5) flying the paper's whole mission under the flight controller.
 //!

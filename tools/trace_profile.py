@@ -17,9 +17,9 @@ with everything LLVM inlined into `Controller::step` sorted back into the paper'
 examples/trace_step.rs (one `Controller::step` a tick, built with the flight profile:
 `cargo build --profile firmware --target thumbv7em-none-eabihf --features firmware
 --example trace_step`), and the
-instructions counted are those from the N-th entry into `Controller::decide` (the step less its
-event bookkeeping, which is inlined into the caller with `Controller::run`) to the return to
-the caller. The trace is streamed through a pipe, not stored (a late step is some 4·10^7 lines in).
+instructions counted are those from the N-th entry into `Controller::run` (the step: decide,
+then report; or `Controller::step` or `::decide`, whichever LLVM kept as a function) to the
+return to the caller. The trace is streamed through a pipe, not stored (a late step is some 4·10^7 lines in).
 
 Defaults: the flight firmware (target/thumbv7em-none-eabihf/firmware/tss-reel, build it with
 `cargo fw-build`), tick 301 (a nominal deploy step that logs nothing). Needs qemu-system-arm
@@ -42,7 +42,7 @@ CATEGORIES = [
     ("estimator: prediction (Ψ, Φ, the state)", r"Estimator.*::predict"),
     ("estimator: update (gate, gain, state)", r"Estimator.*::update"),
     ("estimator: the rest", r"estimator::"),
-    ("estimator's wiring (controller::estimation)", r"controller::estimation::|Controller.*::swing|Controller.*::commanded"),
+    ("estimator's wiring (controller::estimation)", r"controller::estimation::|Controller.*::estimate_swing"),
     ("schedule (α_r: BandSchedule/SlewedSchedule)", r"schedule::|Controller.*::reference"),
     ("law::solve: fastmath::sin_cos", r"fastmath::sin_cos.*law::solve"),
     ("law::solve: the square root (tss_fpu, VSQRT.F32)", r"sqrt.*law::solve"),
@@ -50,7 +50,7 @@ CATEGORIES = [
     ("law::acceleration", r"law::acceleration"),
     ("envelope: the square root", r"sqrt.*(Envelope|envelope::)"),
     ("envelope: the rest", r"Envelope|envelope::"),
-    ("blend E and 1 - E (Eq. 29: carried a period, or 2^(-cτ·log2 e) after a gap)", r"expf|fastmath::exp|blend_weight|Blend|Sequencer.*::blend"),
+    ("blend E and 1 - E (Eq. 29: carried a period, or 2^(-cτ·log2 e) after a gap)", r"expf|fastmath::exp|blend_weight|Blend|Sequencer.*::carry_blend_to"),
     ("mass model (coefficients, mu3_rate)", r"MassModel"),
     ("existence check (Eq. 13 margin)", r"equilibrium::|equilibrium_margin"),
     ("sensor validation (Monitor::check)", r"Monitor.*::check"),
@@ -117,13 +117,14 @@ def mission_step_pcs(elf, n):
     from its entry to the return to the caller (the instruction after the caller's `bl`)."""
     nm = subprocess.run(["llvm-nm", "--defined-only", elf], capture_output=True,
                         text=True, check=True).stdout
-    # Controller::decide (legacy mangling), or Controller::run where decide is inlined into it.
+    # Controller::run (legacy mangling: decide, then report), or Controller::step where run is
+    # inlined into it, or Controller::decide where neither is a function of its own.
     entries = []
-    for name in ("6decide17h", "3run17h"):
+    for name in ("3run17h", "4step17h", "6decide17h"):
         entries = entries or [int(l.split()[0], 16) & ~1 for l in nm.splitlines()
                               if "Controller" in l and name in l]
     if len(entries) != 1:
-        sys.exit(f"trace_profile: expected one Controller::decide or ::run in {elf}, found {len(entries)}")
+        sys.exit(f"trace_profile: expected one Controller::run, ::step or ::decide in {elf}, found {len(entries)}")
     entry = entries[0]
     with tempfile.TemporaryDirectory() as tmp:
         fifo = os.path.join(tmp, "trace.fifo")

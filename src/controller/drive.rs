@@ -1,5 +1,6 @@
-//! The reel drive's faults in the outer fault logic (issue 19): one outer step that knows
-//! what the inner speed loop ([`crate::reel_drive`]) went through during the period.
+//! The reel drive's faults in the outer fault logic: one outer step that knows what the inner
+//! speed loop ([`crate::reel_drive`]) went through during the period, and the command the
+//! inner loop takes from a step's output.
 //!
 //! The speed loop runs at the inner rate and reports typed faults every tick
 //! ([`DriveFaults`]); the caller takes their union over the law period and hands it to
@@ -16,9 +17,9 @@
 //!   count again.
 
 use crate::real::Real;
-use crate::reel_drive::{DriveFaults, OuterReaction};
+use crate::reel_drive::{DriveFaults, OuterReaction, RateCommand};
 
-use super::{Controller, Flags, Input, Output};
+use super::{Controller, Health, Input, Output};
 
 impl<T: Real> Controller<T> {
     /// One control period whose reel drive reported `drive` (the union of its inner ticks'
@@ -31,7 +32,6 @@ impl<T: Real> Controller<T> {
         sample: Option<&Input<T>>,
         drive: DriveFaults,
     ) -> &Output<T> {
-        let health = self.health.health();
         let sample = match drive.outer_reaction() {
             OuterReaction::Report => sample,
             OuterReaction::Degrade => None,
@@ -40,12 +40,18 @@ impl<T: Real> Controller<T> {
                 None
             }
         };
-        self.decide(tick, sample);
-        // A forced safe hold changed the health before the step: flag it as the step would.
-        self.out
-            .flags
-            .set_if(self.out.health != health, Flags::HEALTH_CHANGED);
-        self.record_events();
-        &self.out
+        self.run(tick, sample)
+    }
+}
+
+/// The inner loop's command of one law period: the step's rate and acceleration, and whether
+/// the controller is in safe hold (the brake may engage but not release).
+impl From<&Output<f32>> for RateCommand {
+    fn from(o: &Output<f32>) -> Self {
+        Self {
+            rate_mps: o.rate_cmd_mps,
+            accel_mps2: o.accel_cmd_mps2,
+            safe_hold: o.health == Health::SafeHold,
+        }
     }
 }

@@ -5,9 +5,7 @@
 //! it (see the controller's docs, *Flying on the estimator*).
 
 use crate::config::{estimator_error, ConfigError};
-use crate::estimator::{
-    self, Drive, DriveChecks, Estimate, Estimator, Measurement, Prediction, MAX_ORBIT_RATE_RADPS,
-};
+use crate::estimator::{self, Drive, Estimate, Estimator, Measurement, Prediction};
 use crate::monitor::Sensor;
 use crate::orbit::Orbit;
 use crate::real::Real;
@@ -70,14 +68,9 @@ pub(super) struct Estimation<T: Real> {
     eccentric: Option<Orbit<T>>,
     /// Var(α̂) beyond which the law may not use the estimate, rad².
     max_alpha_var_rad2: T,
-    /// What the filter checks of the drives this builds: the stretch alone where the orbit
-    /// terms are in range by construction (see [`Estimation::new`]), all otherwise.
-    checks: DriveChecks,
     /// The orbit's terms at the last accepted sample (a period without one is carried with
     /// them); before the first, the configured orbit's at periapsis (no estimate to carry
     /// then: the estimate starts from an accepted sample's α).
-    // Not an `Option`: its tag stored every step and tested by every prediction cost 5
-    // instructions a step (scripts/bench-target, mission median/worst 865/885 → 858/880).
     orbit: OrbitTerms<T>,
     /// What the last step commanded (`None` before the first step).
     commanded: Option<Commanded<T>>,
@@ -90,36 +83,16 @@ pub(super) struct Estimation<T: Real> {
 }
 
 impl<T: Real> Estimation<T> {
-    /// The estimator of `cfg` (validated with the controller's configuration) on `orbit`, with
-    /// samples whose θ̇ the monitor bounds to `orbit_rate_range_radps` (validated: positive).
-    ///
-    /// The drives it builds have the filter check the stretch alone ([`DriveChecks::Stretch`])
-    /// when their orbit terms are in the filter's ranges by construction: a circular orbit
-    /// (θ̈ = 0, μ/R³ = θ̇²) with θ̇ at most [`MAX_ORBIT_RATE_RADPS`] and θ̇² > 0 in `T` over the
-    /// whole range. On an eccentric orbit θ̈ and μ/R³ come from the sensed θ, which nothing
-    /// bounds: the filter checks every input.
-    pub(super) fn new(
-        cfg: &estimator::Config<T>,
-        orbit: &Orbit<T>,
-        orbit_rate_range_radps: (T, T),
-    ) -> Result<Self, ConfigError> {
+    /// The estimator of `cfg` (validated with the controller's configuration) on `orbit`.
+    pub(super) fn new(cfg: &estimator::Config<T>, orbit: &Orbit<T>) -> Result<Self, ConfigError> {
         let filter = Estimator::new(*cfg).map_err(estimator_error)?;
         let max_alpha_var_rad2 =
             T::from_f64(MAX_ALPHA_VARIANCE_IN_SAMPLES) * filter.measurement_var_rad2();
         let eccentric = (orbit.eccentricity > T::ZERO).then_some(*orbit);
-        let (min, max) = orbit_rate_range_radps;
-        let in_range = min > T::ZERO && min * min > T::ZERO;
-        let checks = if eccentric.is_none() && in_range && max <= T::from_f64(MAX_ORBIT_RATE_RADPS)
-        {
-            DriveChecks::Stretch
-        } else {
-            DriveChecks::All
-        };
         Ok(Self {
             filter,
             eccentric,
             max_alpha_var_rad2,
-            checks,
             orbit: OrbitTerms {
                 rate_radps: orbit.true_anomaly_rate_radps(T::ZERO),
                 // sin θ = 0 at periapsis; 0 for good on a circular orbit (`sense_orbit`).
@@ -139,16 +112,8 @@ impl<T: Real> Estimation<T> {
 
     /// The law computed sin 2α and cos 2α for `alpha_rad`, the α̂ of this step's
     /// [`Estimated::Usable`] verdict: the next prediction reuses them.
-    // The law flies on the verdict's α̂ and nothing moves the estimate between the verdict and
-    // this call, so the filter need not compare the angles (a debug assertion does): the
-    // comparison (and the angle kept across the law for it) took 3 instructions a step
-    // (scripts/bench-target, mission median 898 → 895).
     pub(super) fn lend_sin_cos_two_alpha(&mut self, alpha_rad: T, sin: T, cos: T) {
-        debug_assert_eq!(
-            self.filter.alpha_rate_and_variance().map(|(a, _, _)| a),
-            Some(alpha_rad)
-        );
-        self.filter.lend_sin_cos_two_alpha_hat(sin, cos);
+        self.filter.lend_sin_cos_two_alpha(alpha_rad, sin, cos);
     }
 
     /// The end of a step: it commanded `c` for the coming period (the drive of the next
@@ -179,10 +144,10 @@ impl<T: Real> Estimation<T> {
         // The last period with the encoder's rate (that of the period that just ended), after
         // the periods of a gap in the calls. One period, the common case, tested first.
         let lost = match periods {
-            1 => self.carry(0, reel_rate_mps),
             0 => false,
-            2..=MAX_CARRIED_PERIODS => {
-                let gap_lost = self.carry_gap(periods - 1);
+            1..=MAX_CARRIED_PERIODS => {
+                // The periods of a gap in the calls at the last command, then the last one.
+                let gap_lost = periods > 1 && self.carry_gap(periods - 1);
                 let last_lost = self.carry(periods - 1, reel_rate_mps);
                 gap_lost || last_lost
             }
@@ -192,8 +157,7 @@ impl<T: Real> Estimation<T> {
                 had
             }
         };
-        // The monitor checked α: |α| ≤ π.
-        let m = self.filter.update_with_angle(alpha_rad);
+        let m = self.filter.update_with(alpha_rad);
         let estimate = self.filter.alpha_rate_and_variance();
         let (nis, event) = match m {
             Measurement::Accepted(i) | Measurement::Gated(i) => (Some(i.nis), None),
@@ -232,7 +196,7 @@ impl<T: Real> Estimation<T> {
     fn carry(&mut self, k: u32, reel_rate_mps: Option<T>) -> bool {
         match self.drive(k, reel_rate_mps) {
             Some(drive) => matches!(
-                self.filter.predict_period_checking(&drive, self.checks),
+                self.filter.predict_period(&drive),
                 Prediction::InvalidDrive(_) | Prediction::Diverged
             ),
             None => {
@@ -245,9 +209,8 @@ impl<T: Real> Estimation<T> {
     /// Carries the estimate over the first `periods` periods since the last step (a gap in the
     /// calls: at most [`MAX_CARRIED_PERIODS`] − 1), at the last command; `true` if the filter
     /// dropped it.
-    // Out of line: the loop inlined into the step cost 148 instructions on every nominal step
-    // (one period, no gap), its iterator's state spilled around the whole prediction
-    // (tools/trace_profile.py, tick 301).
+    // Out of line: inlined, the gap's loop kept its state across the nominal one-period carry,
+    // and the outer step exceeded its ceiling (scripts/bench-target).
     #[inline(never)]
     fn carry_gap(&mut self, periods: u32) -> bool {
         let mut lost = false;
@@ -259,8 +222,6 @@ impl<T: Real> Estimation<T> {
 
     /// Keeps the orbit's terms at a sample: θ̈ and μ/R³ from θ on an eccentric orbit, θ̇² on a
     /// circular one (whose θ̈ is the 0 it starts with).
-    // θ̈ = 0 not stored again every step: mission median/worst 858/880 → 855/878
-    // (scripts/bench-target).
     fn sense_orbit(&mut self, rate_radps: T, true_anomaly_rad: T) {
         match &self.eccentric {
             Some(o) => {
@@ -305,39 +266,10 @@ impl<T: Real> Estimation<T> {
 mod tests {
     use super::*;
 
-    /// The monitor's default θ̇ range.
-    const RATES: (f64, f64) = (1e-5, 1e-2);
-
-    #[test]
-    fn the_filter_checks_the_stretch_alone_only_where_the_orbit_terms_are_in_range() {
-        let cfg = estimator::Config::<f64>::paper();
-        let circular = Orbit::circular(7_078_000.0);
-        let checks =
-            |orbit: &Orbit<f64>, rates| Estimation::new(&cfg, orbit, rates).unwrap().checks;
-        assert_eq!(checks(&circular, RATES), DriveChecks::Stretch);
-        assert_eq!(
-            checks(&circular, (1e-3, MAX_ORBIT_RATE_RADPS)),
-            DriveChecks::Stretch
-        );
-        // A θ̇ the filter refuses could pass the monitor: every input is checked.
-        assert_eq!(
-            checks(&circular, (1e-3, 2.0 * MAX_ORBIT_RATE_RADPS)),
-            DriveChecks::All
-        );
-        // θ̇² would underflow to 0 at the bottom of the range (in f32 too: 1e-30² < 1e-45).
-        let est32 = estimator::Config::<f32>::paper();
-        let tiny = Estimation::new(&est32, &Orbit::circular(7_078_000.0), (1e-30, 2e-3)).unwrap();
-        assert_eq!(tiny.checks, DriveChecks::All);
-        assert_eq!(
-            checks(&Orbit::elliptic(7_078_000.0, 0.1), RATES),
-            DriveChecks::All
-        );
-    }
-
     #[test]
     fn the_drive_takes_the_orbit_terms_from_theta_on_an_eccentric_orbit_only() {
         let cfg = estimator::Config::<f64>::paper();
-        let mut circular = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), RATES).unwrap();
+        let mut circular = Estimation::new(&cfg, &Orbit::circular(7_078_000.0)).unwrap();
         let n = 1.06e-3;
         circular.sense_orbit(n, 2.0);
         let t = circular.orbit;
@@ -345,7 +277,7 @@ mod tests {
         assert_eq!(t.accel_radps2.to_bits(), 0.0_f64.to_bits());
         assert_eq!(t.gravity_gradient_per_s2, n * n);
         let orbit = Orbit::elliptic(7_078_000.0, 0.1);
-        let mut eccentric = Estimation::new(&cfg, &orbit, RATES).unwrap();
+        let mut eccentric = Estimation::new(&cfg, &orbit).unwrap();
         let theta = 2.0;
         eccentric.sense_orbit(n, theta);
         let t = eccentric.orbit;
@@ -361,7 +293,7 @@ mod tests {
     #[test]
     fn the_drive_is_the_last_command_or_the_measured_mean_rate() {
         let cfg = estimator::Config::<f64>::paper();
-        let mut e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), RATES).unwrap();
+        let mut e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0)).unwrap();
         assert_eq!(e.drive(0, None), None);
         e.sense_orbit(1.06e-3, 0.0);
         let c = Commanded {

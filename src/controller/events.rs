@@ -1,11 +1,7 @@
 //! The controller's events: what happened in a step, worth telling the ground about once, in
-//! a bounded ring that keeps the newest events and counts the ones it had to drop.
-//!
-//! Why not `heapless::Deque`: it was tried. Its `push_back` (a full check, then an index
-//! increment with wrap-around, and the write) cost about 25 instructions per event on the
-//! Cortex-M4F, against about 5 for this ring's one store and one increment; the step that
-//! starts stage 2 records two events and is the mission's worst step, where the deque cost
-//! about 40 instructions more (`scripts/bench-target`: worst step 603 with the deque).
+//! a bounded queue that keeps the newest events and counts the ones it had to drop.
+
+use heapless::Deque;
 
 use super::output::{Fault, Health, Phase};
 
@@ -53,76 +49,55 @@ pub struct Event {
     pub kind: EventKind,
 }
 
-/// The controller's event queue: a ring of [`EVENT_CAPACITY`] events in which a new event
-/// overwrites the oldest unread one when the ring is full. The writer and the reader each
-/// keep a free-running count (wrapping): a push is one store and one increment, with no test,
-/// so a step that records events stays close to a quiet one; the reader finds any events
-/// overwritten since it last read (more than [`EVENT_CAPACITY`] unread) and counts them as
-/// dropped.
+/// The controller's event queue: [`EVENT_CAPACITY`] events; when it is full a new event takes
+/// the place of the oldest unread one, which is counted as dropped.
 #[derive(Clone, Debug)]
-pub(super) struct EventRing {
-    buf: [Event; EVENT_CAPACITY],
-    /// Events ever written (wrapping); the next is written at `written mod capacity`.
-    written: u32,
-    /// Events ever read or dropped (wrapping).
-    read: u32,
-    /// Events dropped, up to the last read.
+pub(super) struct EventQueue {
+    queue: Deque<Event, EVENT_CAPACITY>,
+    /// Events dropped so far (saturating).
     dropped: u32,
 }
 
-const _: () = assert!(EVENT_CAPACITY.is_power_of_two() && EVENT_CAPACITY <= u32::MAX as usize);
-
-impl EventRing {
-    const CAPACITY: u32 = EVENT_CAPACITY as u32;
-
+impl EventQueue {
     pub(super) const fn new() -> Self {
         Self {
-            buf: [Event {
-                tick: 0,
-                kind: EventKind::BlendRestart,
-            }; EVENT_CAPACITY],
-            written: 0,
-            read: 0,
+            queue: Deque::new(),
             dropped: 0,
         }
     }
 
-    /// Appends `e`; when the ring is full it takes the oldest unread event's slot.
+    /// Appends `e`; when the queue is full the oldest unread event makes room for it.
     pub(super) fn push(&mut self, e: Event) {
-        self.buf[self.written as usize & (EVENT_CAPACITY - 1)] = e;
-        self.written = self.written.wrapping_add(1);
-    }
-
-    /// Unread events overwritten since the last read.
-    fn overwritten(&self) -> u32 {
-        self.written
-            .wrapping_sub(self.read)
-            .saturating_sub(Self::CAPACITY)
-    }
-
-    /// Takes the oldest unread event (first counting any that were overwritten).
-    pub(super) fn pop(&mut self) -> Option<Event> {
-        let lost = self.overwritten();
-        self.dropped = self.dropped.saturating_add(lost);
-        self.read = self.read.wrapping_add(lost);
-        if self.read == self.written {
-            return None;
+        if self.queue.is_full() {
+            self.queue.pop_front();
+            self.dropped = self.dropped.saturating_add(1);
         }
-        let e = self.buf[self.read as usize & (EVENT_CAPACITY - 1)];
-        self.read = self.read.wrapping_add(1);
-        Some(e)
+        // Room was made above: the push cannot fail.
+        let _ = self.queue.push_back(e);
     }
 
-    /// Events dropped so far, including those overwritten and not yet counted by a read.
+    /// Appends the event of `kind` at `tick`, if there is one.
+    pub(super) fn record(&mut self, tick: u32, kind: Option<EventKind>) {
+        if let Some(kind) = kind {
+            self.push(Event { tick, kind });
+        }
+    }
+
+    /// Takes the oldest unread event.
+    pub(super) fn pop(&mut self) -> Option<Event> {
+        self.queue.pop_front()
+    }
+
+    /// Events dropped so far.
     pub(super) fn dropped(&self) -> u32 {
-        self.dropped.saturating_add(self.overwritten())
+        self.dropped
     }
 }
 
 #[cfg(test)]
 mod tests {
     extern crate std;
-    use super::{Event, EventKind, EventRing, Phase, EVENT_CAPACITY};
+    use super::{Event, EventKind, EventQueue, Phase, EVENT_CAPACITY};
     use std::{vec, vec::Vec};
 
     fn event(i: u32) -> Event {
@@ -132,13 +107,13 @@ mod tests {
         }
     }
 
-    fn drain(q: &mut EventRing) -> Vec<u32> {
+    fn drain(q: &mut EventQueue) -> Vec<u32> {
         core::iter::from_fn(|| q.pop()).map(|e| e.tick).collect()
     }
 
     #[test]
     fn ring_keeps_the_newest_and_counts_the_overwritten() {
-        let mut ring = EventRing::new();
+        let mut ring = EventQueue::new();
         assert_eq!(ring.pop(), None);
         for i in 0..3 {
             ring.push(event(i));
@@ -162,19 +137,5 @@ mod tests {
         }
         assert_eq!(ring.dropped(), 5 + 9);
         assert_eq!(drain(&mut ring), (34..50).collect::<Vec<u32>>());
-    }
-
-    #[test]
-    fn ring_counters_wrap_around() {
-        let mut ring = EventRing::new();
-        ring.written = u32::MAX - 2;
-        ring.read = u32::MAX - 2;
-        for i in 0..EVENT_CAPACITY as u32 + 2 {
-            ring.push(event(i));
-        }
-        assert_eq!(ring.written, EVENT_CAPACITY as u32 - 1);
-        assert_eq!(ring.dropped(), 2);
-        assert_eq!(drain(&mut ring), (2..18).collect::<Vec<u32>>());
-        assert_eq!((ring.pop(), ring.dropped()), (None, 2));
     }
 }

@@ -4,7 +4,7 @@
 use crate::config::MonitorConfig;
 use crate::real::Real;
 
-use super::output::{Flags, Health};
+use super::output::Health;
 
 /// The fault state machine, with persistence and rate (FDIR): a leaky counter of unusable
 /// samples (see [`MonitorConfig::good_samples_per_bad`]), and how long the inputs have been
@@ -33,16 +33,9 @@ impl HealthMachine {
         self.health
     }
 
-    fn set(&mut self, h: Health, flags: &mut Flags) {
-        if self.health != h {
-            self.health = h;
-            flags.set(Flags::HEALTH_CHANGED);
-        }
-    }
-
     /// A usable sample that the law could use: Nominal, and the counter leaks by one.
-    pub(super) fn usable(&mut self, flags: &mut Flags) {
-        self.set(Health::Nominal, flags);
+    pub(super) fn usable(&mut self) {
+        self.health = Health::Nominal;
         if self.fault_level > 0 {
             self.fault_level -= 1;
         }
@@ -52,17 +45,16 @@ impl HealthMachine {
     /// exceeds `coast_ticks × good_samples_per_bad` (`coast_ticks + 1` bad samples in a row
     /// from a clean record, sooner after recent faults): then SafeHold, which only
     /// `recovery_ticks` valid samples in a row leave (see [`HealthMachine::recovered`]).
-    pub(super) fn unusable<T>(&mut self, cfg: &MonitorConfig<T>, flags: &mut Flags) {
+    pub(super) fn unusable<T>(&mut self, cfg: &MonitorConfig<T>) {
         self.fault_level = self.fault_level.saturating_add(cfg.good_samples_per_bad);
         self.good_ticks = 0;
         // (`Config::validate` checks that the product does not saturate.)
         let limit = cfg.coast_ticks.saturating_mul(cfg.good_samples_per_bad);
-        let next = if self.health == Health::SafeHold || self.fault_level > limit {
+        self.health = if self.health == Health::SafeHold || self.fault_level > limit {
             Health::SafeHold
         } else {
             Health::Degraded
         };
-        self.set(next, flags);
     }
 
     /// The reel drive tripped (`drive`): safe hold at once, and the run of valid samples that

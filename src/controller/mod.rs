@@ -29,11 +29,22 @@
 //! assert_eq!(ctl.output(), &out);
 //! ```
 //!
-//! A step reads as the paper's loop and PX4's `PositionControl` do: check the inputs
-//! ([`crate::monitor`]) → sequence the mission (`sequencer`: stages, phases, the Eq. 29
-//! blend, α_r) → the law ([`crate::law`]) → the envelope ([`crate::envelope`]) → the output
-//! and its events. Without a usable sample the health state machine (`health`) takes a
-//! safe action on the dead-reckoned length instead of the law.
+//! A step reads as the paper's loop and PX4's `PositionControl` do, one stage after another,
+//! each handing the next a typed value:
+//!
+//! ```text
+//!   check     the sample (crate::monitor)                       → the accepted sample
+//!   estimate  α and α̇: sensed, or the onboard EKF's             → Sensed
+//!   sequence  stages, phases, α_r (sequencer)                    → Reference
+//!   law       Eqs. 27 + 29 and the Eq. 30 acceleration           → Solved (the demand)
+//!   limit     the envelope and the protection's bounds           → Decided (the command)
+//!   report    the output, and the events of what changed since the last report
+//! ```
+//!
+//! A stage that finds nothing the law may fly on (no usable sample, no estimate, a singular
+//! point of the law, safe hold not yet recovered) hands over to the safe action instead
+//! (`hold`), which the health state machine (`health`) chooses on the dead-reckoned length;
+//! its command is reported the same way.
 //!
 //! Time is an integer tick count (one tick = one control period); the controller never
 //! accumulates time in floating point.
@@ -66,28 +77,30 @@ mod output;
 pub(crate) mod protection;
 mod sequencer;
 
-use crate::envelope::PreparedEnvelope;
+use crate::envelope::{Bounds, PreparedEnvelope};
 use crate::equilibrium::ExistenceMonitor;
 use crate::estimator::Estimate;
 use crate::law::{self, LawInput};
 use crate::monitor::{Monitor, Swing, SPOOL_MARGIN};
 use crate::real::Real;
+use crate::schedule::Reference;
 
 pub use crate::config::{
-    Config, ConfigError, MonitorConfig, RateSource, Rule, Stage1Config, Stage2Config,
+    Config, ConfigError, MonitorConfig, ProtectionConfig, RateSource, Rule, Stage1Config,
+    Stage2Config, MAX_PLAUSIBLE_TENSION_N,
 };
 pub use crate::envelope::Envelope;
 pub use crate::monitor::{Input, Sensor};
 pub use events::{Event, EventKind, EVENT_CAPACITY};
 pub use output::{Fault, Flags, Health, Output, Phase};
-pub use protection::{ProtectionConfig, MARGIN_OF_GRAVITY_GRADIENT, MAX_PLAUSIBLE_TENSION_N};
+pub use protection::MARGIN_OF_GRAVITY_GRADIENT;
 
 use clock::{Clock, Elapsed};
 use estimation::{Commanded, Estimated, Estimation};
-use events::EventRing;
+use events::EventQueue;
 use health::{DeadReckoning, HealthMachine};
-use protection::{Bounds, FreeTensionModel, Protection};
-use sequencer::{Progress, Sequencer};
+use protection::{FreeTensionModel, Protection};
+use sequencer::Sequencer;
 
 pub use estimation::{MAX_ALPHA_VARIANCE_IN_SAMPLES, MAX_CARRIED_PERIODS};
 pub use sequencer::PROGRESS_TIME_CONSTANTS;
@@ -115,17 +128,124 @@ pub struct Controller<T: Real> {
     /// The safe hold's largest change of rate in one period, m/s: the smaller of
     /// `monitor.safe_hold_decel_mps2` and the envelope's acceleration limit, times the period.
     safe_hold_step_mps: T,
-    /// The command of the last step, m/s (l̇0 before the first).
-    last_rate_cmd_mps: T,
-    /// The health of the last step (the `from` of a change of health, an event).
-    last_health: Health,
-    /// The fault of the last step (a fault is an event when it differs from the last).
-    last_fault: Option<Fault>,
-    /// The last step's command was tension limited (the limit beginning is an event).
-    last_tension_limited: bool,
-    events: EventRing,
+    /// The command of the last step: the reel ran at it over the period that just ended (l̇0
+    /// and no acceleration before the first step).
+    last_command: Command<T>,
+    /// What the last step reported, the "before" of this step's events.
+    reported: Reported,
+    events: EventQueue,
     /// The last step's output ([`Controller::output`]).
     out: Output<T>,
+}
+
+/// A command for the coming period: the reel rate and its acceleration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Command<T> {
+    /// Reel-rate command l̇_real, m/s.
+    rate_mps: T,
+    /// Commanded reel acceleration, m/s².
+    accel_mps2: T,
+}
+
+/// A period in which time moved: how far, and the length predicted for its end.
+#[derive(Clone, Copy, Debug)]
+struct Period<T> {
+    /// The tick time moved to.
+    tick: u32,
+    /// Periods since the last accepted tick (0 at the first step).
+    elapsed_ticks: u32,
+    /// The length dead-reckoned from the last command, m (`None` before the first accepted
+    /// sample).
+    predicted_m: Option<T>,
+}
+
+/// A sample the law may fly on: checked, with the α and α̇ it flies on (sensed, or the
+/// estimator's).
+#[derive(Clone, Copy, Debug)]
+struct Sensed<'a, T> {
+    input: &'a Input<T>,
+    alpha_rad: T,
+    alpha_rate_radps: T,
+}
+
+/// Why the law does not fly this period, and what the safe action knows.
+#[derive(Clone, Copy, Debug)]
+struct Unusable<T> {
+    fault: Fault,
+    /// The length to coast from: the prediction, or the sensed length of a valid sample the
+    /// law could not use, m.
+    length_m: Option<T>,
+    /// α_r, when the reference was already worked out at the sensed length, rad.
+    alpha_ref_rad: Option<T>,
+}
+
+/// What the sequencer makes of a usable sample.
+#[derive(Clone, Copy, Debug)]
+enum Sequenced<T> {
+    /// The law flies on this reference.
+    Law(Reference<T>),
+    /// Safe hold goes on until the inputs have recovered; α_r at the sensed length, rad.
+    Recovering { alpha_ref_rad: T },
+}
+
+/// The law's solution of this period (Eqs. 27, 29, 30): the command it asks for before the
+/// limits, and what the limits and the report need of it.
+#[derive(Clone, Copy, Debug)]
+struct Solved<T> {
+    demand: Command<T>,
+    parts: LawParts<T>,
+    /// μ3 at the sensed length.
+    mu3: T,
+    /// The reduced length the law's normalised rate is worked out at, m.
+    reduced_length_m: T,
+    /// The Eq. 29 blend weight E.
+    blend_weight: T,
+    /// The state of Eq. 5a's free tension, for the protection (`None`: no protection).
+    free_tension: Option<FreeTensionModel<T>>,
+}
+
+/// A step's command, limited, with what the report says about it.
+#[derive(Clone, Copy, Debug)]
+struct Decided<T> {
+    command: Command<T>,
+    /// The length the command was judged at (sensed or estimated), m.
+    length_m: T,
+    /// μ3 at that length.
+    mu3: T,
+    /// The normalised rate x = (2 + μ3) l̇/(ωl) of the command (Eq. 7).
+    normalised_rate: T,
+    /// α_r, rad.
+    alpha_ref_rad: T,
+    /// The Eq. 29 blend weight E.
+    blend_weight: T,
+    /// The law's parts (zero when a safe action stood in for the law).
+    law: LawParts<T>,
+    /// The limits that acted, and the step's own status bits.
+    flags: Flags,
+    /// The fault behind a safe action.
+    fault: Option<Fault>,
+}
+
+/// The parts of the law's solution the output reports.
+#[derive(Clone, Copy, Debug)]
+struct LawParts<T> {
+    law_rate_mps: T,
+    ref_rate_radps: T,
+    delta_rad: T,
+    delta_rate_radps: T,
+}
+
+/// What a step reported that an event tells when it changes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Reported {
+    health: Health,
+    phase: Phase,
+    fault: Option<Fault>,
+    /// How many times the Eq. 29 blend has (re)started.
+    blend_restarts: u32,
+    /// The phase was found no longer getting closer to its keep length.
+    stalled: bool,
+    tension_limited: bool,
 }
 
 impl<T: Real> Controller<T> {
@@ -144,14 +264,9 @@ impl<T: Real> Controller<T> {
         let spool_m = T::from_f64(cfg.envelope.max_length_m.to_f64() * (1.0 + SPOOL_MARGIN));
         let estimation = match &cfg.rate_source {
             RateSource::Sensor => None,
-            RateSource::Estimator(est) => {
-                let rates = (
-                    cfg.monitor.min_orbit_rate_radps,
-                    cfg.monitor.max_orbit_rate_radps,
-                );
-                Some(Estimation::new(est, &cfg.orbit, rates)?)
-            }
+            RateSource::Estimator(est) => Some(Estimation::new(est, &cfg.orbit)?),
         };
+        let sequencer = Sequencer::new(&cfg);
         Ok(Self {
             envelope: PreparedEnvelope::new(cfg.envelope),
             protection: cfg.protection.map(|p| {
@@ -167,7 +282,15 @@ impl<T: Real> Controller<T> {
             existence,
             monitor: Monitor::new(spool_m, estimation.is_none())?,
             estimation,
-            sequencer: Sequencer::new(&cfg),
+            reported: Reported {
+                health: Health::Nominal,
+                phase: sequencer.phase(),
+                fault: None,
+                blend_restarts: sequencer.blend_restarts(),
+                stalled: false,
+                tension_limited: false,
+            },
+            sequencer,
             health: HealthMachine::new(),
             length: DeadReckoning::new(spool_m),
             clock: Clock::new(),
@@ -176,11 +299,11 @@ impl<T: Real> Controller<T> {
                 .safe_hold_decel_mps2
                 .min(cfg.envelope.max_accel_mps2)
                 * cfg.period_s,
-            last_rate_cmd_mps: cfg.initial_rate_mps,
-            last_health: Health::Nominal,
-            last_fault: None,
-            last_tension_limited: false,
-            events: EventRing::new(),
+            last_command: Command {
+                rate_mps: cfg.initial_rate_mps,
+                accel_mps2: T::ZERO,
+            },
+            events: EventQueue::new(),
             out: Output {
                 tick: 0,
                 phase: Phase::Deploy,
@@ -209,8 +332,7 @@ impl<T: Real> Controller<T> {
     }
 
     /// Flying on the estimator: the estimate after the last step (`None` before the first α,
-    /// after the estimate was lost, and on the rate sensor). By value: the filter keeps its
-    /// state in its own form, and a step need not copy it out for a caller who may not ask.
+    /// after the estimate was lost, and on the rate sensor).
     pub fn estimate(&self) -> Option<Estimate<T>> {
         self.estimation.as_ref().and_then(Estimation::estimate)
     }
@@ -251,9 +373,6 @@ impl<T: Real> Controller<T> {
 
     /// One control period with a fresh sensor sample: the command for the coming period and
     /// what it was made of, the output the controller keeps ([`Controller::output`]).
-    // By reference, not a copy: the caller copies it out only if it keeps it (the firmware
-    // reads it in place), 10 instructions less a step (scripts/bench-target, mission
-    // 898/918 → 885/908, replay 885/955 → 875/945).
     pub fn step(&mut self, input: &Input<T>) -> &Output<T> {
         self.run(input.tick, Some(input))
     }
@@ -265,212 +384,114 @@ impl<T: Real> Controller<T> {
         self.run(tick, None)
     }
 
-    /// A step, then its events and the kept output.
+    /// A step: its command decided, then reported (kept as the last output).
     fn run(&mut self, tick: u32, sample: Option<&Input<T>>) -> &Output<T> {
-        self.decide(tick, sample);
-        self.record_events();
+        let decided = self.decide(tick, sample);
+        self.report(tick, &decided);
         &self.out
     }
 
-    /// Check inputs → sequence the mission → law → envelope → the output, kept in `self.out`.
-    // The output is built in place rather than returned by value and then kept (one copy of
-    // it less): with `record_events` inlined, 10 instructions less on the mission's worst step
-    // (scripts/bench-target: 560 → 550).
-    fn decide(&mut self, tick: u32, sample: Option<&Input<T>>) {
-        let mut flags = Flags::default();
-        let dt = self.cfg.period_s;
+    /// The command of one period: check → estimate → sequence → law → limit, or the safe
+    /// action where a stage finds nothing the law may fly on.
+    fn decide(&mut self, tick: u32, sample: Option<&Input<T>>) -> Decided<T> {
+        let period = match self.clock.advance(tick) {
+            Ok(elapsed) => self.begin_period(tick, elapsed, sample),
+            Err(s) => return self.reject_stale(tick, Fault::Sensor(s)),
+        };
+        let checked = self.check(&period, sample);
+        let sensed = match self.estimate_swing(&period, checked) {
+            Ok(sensed) => sensed,
+            Err(unusable) => return self.reject(tick, unusable),
+        };
+        let reference = match self.sequence(tick, &sensed) {
+            Sequenced::Law(reference) => reference,
+            Sequenced::Recovering { alpha_ref_rad } => {
+                return self.hold(tick, true, alpha_ref_rad, None)
+            }
+        };
+        let solved = match self.law(tick, &sensed, &reference) {
+            Ok(solved) => solved,
+            Err(unusable) => return self.reject(tick, unusable),
+        };
+        self.advance_phase(tick, &sensed, &reference);
+        self.limit(&sensed, &reference, &solved)
+    }
 
-        // The time base: a tick that did not move forward (repeated, or from the past) is a
-        // bad sample, and time does not move (see `clock`).
-        let elapsed_ticks = match self.clock.advance(tick) {
-            Ok(Elapsed::First) => {
-                // Sequence the mission: stage 1 begins with the first step (docs/equations.md §7).
-                self.sequencer.begin_stage1(tick, &mut flags);
+    /// The start of a period in which time moved to `tick`: the mission's stages begin when
+    /// due (stage 1 with the first step, stage 2 at its tick or on command, restarting the
+    /// blend), the protection's drive model runs over the periods that passed, and the length
+    /// is dead-reckoned at the last command.
+    fn begin_period(
+        &mut self,
+        tick: u32,
+        elapsed: Elapsed,
+        sample: Option<&Input<T>>,
+    ) -> Period<T> {
+        let elapsed_ticks = match elapsed {
+            Elapsed::First => {
+                self.sequencer.begin_stage1(tick);
                 0
             }
-            Ok(Elapsed::Ticks(n)) => n,
-            Err(s) => return self.reject_stale(tick, Fault::Sensor(s), flags),
+            Elapsed::Ticks(n) => n,
         };
-        let elapsed_s = T::from_u32(elapsed_ticks) * dt;
+        let last = self.last_command;
         if let Some(p) = &mut self.protection {
             p.advance(
-                self.last_rate_cmd_mps,
-                self.out.accel_cmd_mps2,
+                last.rate_mps,
+                last.accel_mps2,
                 elapsed_ticks,
                 sample.and_then(|x| x.reel_rate_mps),
                 sample.and_then(|x| x.tension_n),
             );
         }
-        // Dead reckoning: the reel ran at the last command since the last step.
-        let predicted_m = self.length.predict(self.last_rate_cmd_mps, elapsed_s);
+        let elapsed_s = T::from_u32(elapsed_ticks) * self.cfg.period_s;
+        let predicted_m = self.length.predict(last.rate_mps, elapsed_s);
+        self.sequencer.begin_stage2_if_due(tick, last.rate_mps);
+        Period {
+            tick,
+            elapsed_ticks,
+            predicted_m,
+        }
+    }
 
-        // Sequence the mission: stage 2 at its tick or on command, restarting the blend.
-        self.sequencer
-            .begin_stage2_if_due(tick, self.last_rate_cmd_mps, &mut flags);
-
-        // Check the inputs. Before the first accepted sample, and in safe hold, there is no
-        // trusted prediction: the next valid sample (re-)anchors it.
+    /// Check the sample ([`crate::monitor`]). Before the first accepted sample, and in safe
+    /// hold, there is no trusted prediction of the length: the next valid sample (re-)anchors
+    /// it.
+    fn check<'a>(
+        &mut self,
+        period: &Period<T>,
+        sample: Option<&'a Input<T>>,
+    ) -> Result<(&'a Input<T>, Swing<T>), Sensor> {
         let expected = match self.health.health() {
             Health::SafeHold => None,
-            Health::Nominal | Health::Degraded => predicted_m,
+            Health::Nominal | Health::Degraded => period.predicted_m,
         };
-        let checked = match sample {
-            None => Err(Sensor::Missing),
-            Some(x) => self
-                .monitor
-                .check(&self.cfg.monitor, x, expected, dt)
-                .map(|swing| (x, swing)),
-        };
-        // The law's α and α̇: sensed, or estimated over the periods that passed (the estimate
-        // is carried over the period whether or not the sample was accepted).
+        let x = sample.ok_or(Sensor::Missing)?;
+        let swing = self
+            .monitor
+            .check(&self.cfg.monitor, x, expected, self.cfg.period_s)?;
+        Ok((x, swing))
+    }
+
+    /// The α and α̇ the law flies on: the sensed ones, or the estimate carried over the periods
+    /// that passed (whether or not the sample was accepted) and updated with the sample's α.
+    /// An estimator event is recorded as it happens.
+    fn estimate_swing<'a>(
+        &mut self,
+        period: &Period<T>,
+        checked: Result<(&'a Input<T>, Swing<T>), Sensor>,
+    ) -> Result<Sensed<'a, T>, Unusable<T>> {
         let (accepted, swing) = match &checked {
             Ok((x, swing)) => (Some(*x), *swing),
             Err(_) => (None, Swing::Angle(None)),
         };
-        let angles = self.swing(tick, elapsed_ticks, accepted, swing);
-        let x = match checked {
-            Ok((x, _)) => x,
-            Err(s) => return self.reject(tick, predicted_m, Fault::Sensor(s), None, flags),
-        };
-        let (alpha_rad, alpha_rate_radps) = match angles {
-            Ok(angles) => angles,
-            Err(s) => {
-                let sensed = Some(x.length_m);
-                return self.reject(tick, sensed, Fault::Sensor(s), None, flags);
-            }
-        };
-        self.length.sensed(x.length_m);
-
-        let reference = self
-            .sequencer
-            .reference_at(tick, x.length_m, x.true_anomaly_rad);
-        if self.health.health() == Health::SafeHold {
-            if !self.health.recovered(&self.cfg.monitor) {
-                return self.hold(tick, Some(tick), reference.angle.angle_rad, None, flags);
-            }
-            // Recovered: re-engage the law through the Eq. 29 blend from the current rate.
-            self.sequencer
-                .restart_blend(tick, self.last_rate_cmd_mps, &mut flags);
-        }
-
-        // The law: Eqs. 27 + 29 solved implicitly, and the Eq. 30 acceleration.
-        let (mu3, mu3_per_m) = self.cfg.masses.mu3_and_slope(x.length_m);
-        let law_in = LawInput {
-            length_m: x.length_m,
-            alpha_rad,
-            alpha_rate_radps,
-            orbit_rate_radps: x.orbit_rate_radps,
-            orbit: reference.orbit,
-            ref_angle_rad: reference.angle.angle_rad,
-            ref_slope_rad_per_m: reference.angle.slope_rad_per_m,
-            ref_curvature_rad_per_m2: reference.angle.curvature_rad_per_m2,
-            ref_time_rate_radps: reference.time_rate_radps,
-            mu3,
-            mu3_per_m,
-            blend: self.sequencer.blend(tick),
-            decay_rate_per_s: self.sequencer.blend_decay_rate_per_s(),
-            initial_rate_mps: self.sequencer.blend_initial_rate_mps(),
-            gains: self.cfg.gains,
-        };
-        let (law, accel_mps2) =
-            match law::solve(&law_in).and_then(|s| Ok((s, law::acceleration(&law_in, &s)?))) {
-                Ok(v) => v,
-                Err(f) => {
-                    let alpha_ref = Some(reference.angle.angle_rad);
-                    return self.reject(tick, Some(x.length_m), Fault::Law(f), alpha_ref, flags);
-                }
-            };
-        self.health.usable(&mut flags);
-        if let Some(est) = &mut self.estimation {
-            est.lend_sin_cos_two_alpha(alpha_rad, law.sin_two_alpha, law.cos_two_alpha);
-        }
-
-        // Sequence the mission: the phase after this step of the law, and its progress. Before
-        // the envelope, which neither reads nor changes them: the slew's flag is not carried
-        // across it (mission worst 928 → 920, scripts/bench-target).
-        flags.set_if(reference.slewing, Flags::SLEWING);
-        match self
-            .sequencer
-            .advance_phase(tick, x.length_m, reference.slewing, &mut flags)
-        {
-            Progress::OnTrack => {}
-            Progress::Stalled { first } => {
-                flags.set(Flags::NO_PROGRESS);
-                if first {
-                    let kind = EventKind::NoProgress(self.sequencer.phase());
-                    self.events.push(Event { tick, kind });
-                }
-            }
-        }
-
-        // The envelope. The acceleration limit holds per command: a command differs from the
-        // previous one by at most a·Δt, whatever the calls' pattern (a gap of n ticks does
-        // not allow n·a·Δt: the reel ran at the previous command all along, and would step).
-        // The protection bounds it further by the tension the tether carries (and the drive).
-        // One match on the protection, the envelope inlined into each arm: without one its
-        // bounds are constants, and cost the step nothing (scripts/bench-target, mission
-        // median 950 → 920, worst 980 → 948).
-        let previous = self.last_rate_cmd_mps;
-        let (env, l) = (&self.envelope, x.length_m);
-        let (rate, accel, sat) = match &mut self.protection {
-            None => env.limit_law(law.rate_mps, accel_mps2, previous, l, dt, &Bounds::none()),
-            Some(p) => {
-                let bounds = p.bounds(Some(&FreeTensionModel::of(&law_in, &law)), previous, dt);
-                env.limit_law(law.rate_mps, accel_mps2, previous, l, dt, &bounds)
-            }
-        };
-        flags.set(sat.0);
-        self.last_rate_cmd_mps = rate;
-
-        // The output.
-        let x_rate = self
-            .existence
-            .normalised_rate_at_reduced_length(law.reduced_length_m, rate);
-        let margin = self.equilibrium_margin(x_rate);
-        flags.set_if(margin < T::ZERO, Flags::NO_EQUILIBRIUM);
-        let nis = self.commanded(x.length_m, accel, mu3);
-        self.out = Output {
-            tick,
-            phase: self.sequencer.phase(),
-            health: self.health.health(),
-            rate_cmd_mps: rate,
-            accel_cmd_mps2: accel,
-            law_rate_mps: law.law_rate_mps,
-            blend_weight: law_in.blend.weight,
-            alpha_ref_rad: reference.angle.angle_rad,
-            alpha_ref_rate_radps: law.ref_rate_radps,
-            delta_rad: law.delta_rad,
-            delta_rate_radps: law.delta_rate_radps,
-            length_estimate_m: x.length_m,
-            equilibrium_margin: margin,
-            nis,
-            flags,
-            fault: None,
-        };
-    }
-
-    /// The α and α̇ the law flies on: the sensed ones, or the estimate carried over the
-    /// `periods` that passed and updated with the α of `swing` (`x`: the accepted sample, if
-    /// any). An estimator event is recorded at `tick`.
-    // Inlined into its one caller: out of line it cost a call, its prologue and the spills of
-    // its arguments: 30 instructions a step (scripts/bench-target, mission: median 1008 → 978,
-    // worst 1045 → 1018).
-    #[inline(always)]
-    fn swing(
-        &mut self,
-        tick: u32,
-        periods: u32,
-        x: Option<&Input<T>>,
-        swing: Swing<T>,
-    ) -> Result<(T, T), Sensor> {
-        match (&mut self.estimation, swing) {
+        let angles = match (&mut self.estimation, swing) {
             (None, Swing::Sensed(alpha_rad, alpha_rate_radps)) => Ok((alpha_rad, alpha_rate_radps)),
             (Some(est), Swing::Angle(alpha_rad)) => {
-                let sample = x.map(|x| (x.orbit_rate_radps, x.true_anomaly_rad, x.reel_rate_mps));
-                let (verdict, event) = est.step(periods, sample, alpha_rad);
-                if let Some(kind) = event {
-                    self.events.push(Event { tick, kind });
-                }
+                let orbit =
+                    accepted.map(|x| (x.orbit_rate_radps, x.true_anomaly_rad, x.reel_rate_mps));
+                let (verdict, event) = est.step(period.elapsed_ticks, orbit, alpha_rad);
+                self.events.record(period.tick, event);
                 match verdict {
                     Estimated::Usable(alpha_rad, alpha_rate_radps) => {
                         Ok((alpha_rad, alpha_rate_radps))
@@ -481,48 +502,169 @@ impl<T: Real> Controller<T> {
             // Not reached: the monitor checks the angles by the same rate source.
             (None, Swing::Angle(_)) => Err(Sensor::AlphaRate),
             (Some(_), Swing::Sensed(..)) => Err(Sensor::AlphaLost),
+        };
+        match (checked, angles) {
+            (Err(s), _) => Err(Unusable {
+                fault: Fault::Sensor(s),
+                length_m: period.predicted_m,
+                alpha_ref_rad: None,
+            }),
+            (Ok((x, _)), Err(s)) => Err(Unusable {
+                fault: Fault::Sensor(s),
+                length_m: Some(x.length_m),
+                alpha_ref_rad: None,
+            }),
+            (Ok((x, _)), Ok((alpha_rad, alpha_rate_radps))) => {
+                self.length.sensed(x.length_m);
+                Ok(Sensed {
+                    input: x,
+                    alpha_rad,
+                    alpha_rate_radps,
+                })
+            }
         }
     }
 
-    /// Flying on the estimator, the end of its step: the command of this step, the drive of
-    /// the next prediction (the reel at `length_m`, at the kept command, accelerating at
-    /// `accel_mps2`). Returns the NIS of this step's α sample for the output.
-    // One test for the estimator for both, where there were two (the command after the output,
-    // the NIS for it): with the last step's health and phase kept as state, mission 905/935 →
-    // 900/928 (scripts/bench-target; the law's sin/cos 2α̂ lent at the end of the step as well
-    // took 5 more: they stayed live across the envelope).
-    fn commanded(&mut self, length_m: T, accel_mps2: T, mu3: T) -> Option<T> {
-        let c = Commanded {
-            length_m,
-            rate_mps: self.last_rate_cmd_mps,
-            accel_mps2,
+    /// Sequence the mission (docs/equations.md §7): α_r of the phase at the sensed length. In
+    /// safe hold the law re-engages only once the inputs have recovered, through the Eq. 29
+    /// blend restarted from the current rate.
+    fn sequence(&mut self, tick: u32, s: &Sensed<T>) -> Sequenced<T> {
+        let x = s.input;
+        let reference = self
+            .sequencer
+            .reference_at(tick, x.length_m, x.true_anomaly_rad);
+        if self.health.health() == Health::SafeHold {
+            if !self.health.recovered(&self.cfg.monitor) {
+                let alpha_ref_rad = reference.angle.angle_rad;
+                return Sequenced::Recovering { alpha_ref_rad };
+            }
+            self.sequencer
+                .restart_blend(tick, self.last_command.rate_mps);
+        }
+        Sequenced::Law(reference)
+    }
+
+    /// The law: Eqs. 27 + 29 solved implicitly for the rate, and the Eq. 30 acceleration. A
+    /// solution makes the sample usable for the health machine; a singular point is a fault.
+    fn law(
+        &mut self,
+        tick: u32,
+        s: &Sensed<T>,
+        reference: &Reference<T>,
+    ) -> Result<Solved<T>, Unusable<T>> {
+        let x = s.input;
+        let (mu3, mu3_per_m) = self.cfg.masses.mu3_and_slope(x.length_m);
+        let input = LawInput {
+            length_m: x.length_m,
+            alpha_rad: s.alpha_rad,
+            alpha_rate_radps: s.alpha_rate_radps,
+            orbit_rate_radps: x.orbit_rate_radps,
+            orbit: reference.orbit,
+            ref_angle_rad: reference.angle.angle_rad,
+            ref_slope_rad_per_m: reference.angle.slope_rad_per_m,
+            ref_curvature_rad_per_m2: reference.angle.curvature_rad_per_m2,
+            ref_time_rate_radps: reference.time_rate_radps,
             mu3,
+            mu3_per_m,
+            blend: self.sequencer.carry_blend_to(tick),
+            decay_rate_per_s: self.sequencer.blend_decay_rate_per_s(),
+            initial_rate_mps: self.sequencer.blend_initial_rate_mps(),
+            gains: self.cfg.gains,
         };
-        match &mut self.estimation {
-            Some(est) => est.end_step(c),
-            None => None,
+        let solved = law::solve(&input).and_then(|solution| {
+            let accel_mps2 = law::acceleration(&input, &solution)?;
+            Ok((solution, accel_mps2))
+        });
+        let (solution, accel_mps2) = solved.map_err(|f| Unusable {
+            fault: Fault::Law(f),
+            length_m: Some(x.length_m),
+            alpha_ref_rad: Some(reference.angle.angle_rad),
+        })?;
+        self.health.usable();
+        if let Some(est) = &mut self.estimation {
+            est.lend_sin_cos_two_alpha(s.alpha_rad, solution.sin_two_alpha, solution.cos_two_alpha);
+        }
+        Ok(Solved {
+            demand: Command {
+                rate_mps: solution.rate_mps,
+                accel_mps2,
+            },
+            parts: LawParts {
+                law_rate_mps: solution.law_rate_mps,
+                ref_rate_radps: solution.ref_rate_radps,
+                delta_rad: solution.delta_rad,
+                delta_rate_radps: solution.delta_rate_radps,
+            },
+            mu3,
+            reduced_length_m: solution.reduced_length_m,
+            blend_weight: input.blend.weight,
+            free_tension: self
+                .protection
+                .is_some()
+                .then(|| FreeTensionModel::of(&input, &solution)),
+        })
+    }
+
+    /// Sequence the mission after a step of the law: the phase at the sensed length, and its
+    /// progress toward its keep length.
+    fn advance_phase(&mut self, tick: u32, s: &Sensed<T>, reference: &Reference<T>) {
+        self.sequencer
+            .advance_phase(tick, s.input.length_m, reference.slewing);
+    }
+
+    /// Limit the law's demand to the envelope and the protection's bounds. The acceleration
+    /// limit holds per command: a command differs from the previous one by at most a·Δt,
+    /// whatever the calls' pattern (a gap of n ticks does not allow n·a·Δt: the reel ran at the
+    /// previous command all along, and would step).
+    fn limit(&mut self, s: &Sensed<T>, reference: &Reference<T>, solved: &Solved<T>) -> Decided<T> {
+        let (l, dt) = (s.input.length_m, self.cfg.period_s);
+        let previous = self.last_command.rate_mps;
+        let bounds = self.bounds(solved.free_tension.as_ref(), previous);
+        let demand = solved.demand;
+        let (rate_mps, accel_mps2, sat) =
+            self.envelope
+                .limit_law(demand.rate_mps, demand.accel_mps2, previous, l, dt, &bounds);
+        let mut flags = Flags(sat.0);
+        flags.set_if(reference.slewing, Flags::SLEWING);
+        Decided {
+            command: Command {
+                rate_mps,
+                accel_mps2,
+            },
+            length_m: l,
+            mu3: solved.mu3,
+            normalised_rate: self
+                .existence
+                .normalised_rate_at_reduced_length(solved.reduced_length_m, rate_mps),
+            alpha_ref_rad: reference.angle.angle_rad,
+            blend_weight: solved.blend_weight,
+            law: solved.parts,
+            flags,
+            fault: None,
+        }
+    }
+
+    /// The protection's bounds of this step, from the law's state `model` (`None` when the law
+    /// did not run: the model is stale, the free tension the load cell's own); none without a
+    /// protection.
+    fn bounds(&mut self, model: Option<&FreeTensionModel<T>>, previous_mps: T) -> Bounds<T> {
+        match &mut self.protection {
+            Some(p) => p.bounds(model, previous_mps, self.cfg.period_s),
+            None => Bounds::none(),
         }
     }
 
     /// No usable sample or no law solution at this tick: the health machine counts it, and
-    /// `length_m` (the prediction, or the sensed length of a valid sample the law could not
-    /// use) becomes the length estimate. Then the safe action.
-    fn reject(
-        &mut self,
-        tick: u32,
-        length_m: Option<T>,
-        fault: Fault,
-        alpha_ref_rad: Option<T>,
-        mut flags: Flags,
-    ) {
-        self.length.coast(length_m);
-        self.health.unusable(&self.cfg.monitor, &mut flags);
+    /// the length to coast from becomes the length estimate. Then the safe action.
+    fn reject(&mut self, tick: u32, unusable: Unusable<T>) -> Decided<T> {
+        self.length.coast(unusable.length_m);
+        self.health.unusable(&self.cfg.monitor);
         // Without a usable sample, α_r is reported at the estimated length.
-        let alpha_ref_rad = alpha_ref_rad.unwrap_or_else(|| {
+        let alpha_ref_rad = unusable.alpha_ref_rad.unwrap_or_else(|| {
             let l = self.length.length_m().unwrap_or(T::ZERO);
             self.sequencer.reference(tick, l).angle.angle_rad
         });
-        self.hold(tick, Some(tick), alpha_ref_rad, Some(fault), flags)
+        self.hold(tick, true, alpha_ref_rad, Some(unusable.fault))
     }
 
     /// A sample whose tick did not move forward: a bad sample for the health machine, at a
@@ -530,82 +672,152 @@ impl<T: Real> Controller<T> {
     /// passed for the acceleration limit to allow a change, in any health state); α_r and the
     /// blend are reported at the last accepted tick. A clock that stops for good therefore
     /// ends in safe hold with the command held where it was, until time moves again.
-    fn reject_stale(&mut self, tick: u32, fault: Fault, mut flags: Flags) {
-        self.health.unusable(&self.cfg.monitor, &mut flags);
+    fn reject_stale(&mut self, tick: u32, fault: Fault) -> Decided<T> {
+        self.health.unusable(&self.cfg.monitor);
         // (Only a tick after an accepted one can be stale or repeated.)
         let now = self.clock.last_tick().unwrap_or(tick);
         let l = self.length.length_m().unwrap_or(T::ZERO);
         let alpha_ref_rad = self.sequencer.reference(now, l).angle.angle_rad;
-        self.hold(tick, None, alpha_ref_rad, Some(fault), flags)
+        self.hold(now, false, alpha_ref_rad, Some(fault))
     }
 
-    /// The safe actions at `tick`: `moved_to` is `Some(tick)` when time moved to it, `None`
-    /// when the tick did not move forward (time stays at the last accepted tick). Degraded:
-    /// keep the last command (coast). Safe hold: ramp the rate to zero at
+    /// The safe actions at `now` (`time_moved`: to `now`; otherwise `now` is the last accepted
+    /// tick). Degraded: keep the last command (coast). Safe hold: ramp the rate to zero at
     /// `monitor.safe_hold_decel_mps2` (at most the envelope's limit). When time did not move,
     /// the command stays. All stay inside the length limits, judged on the estimated length
     /// (before any accepted sample, on the docking end: 0 m).
     fn hold(
         &mut self,
-        tick: u32,
-        moved_to: Option<u32>,
+        now: u32,
+        time_moved: bool,
         alpha_ref_rad: T,
         fault: Option<Fault>,
-        mut flags: Flags,
-    ) {
-        flags.set(Flags::SAFE_ACTION);
-        flags.set_if(self.sequencer.stalled(), Flags::NO_PROGRESS);
-        let now = moved_to.or(self.clock.last_tick()).unwrap_or(tick);
+    ) -> Decided<T> {
         let dt = self.cfg.period_s;
-        let previous = self.last_rate_cmd_mps;
-        let target = match (moved_to, self.health.health()) {
-            (None, _) | (Some(_), Health::Degraded) => previous,
-            (Some(_), Health::Nominal | Health::SafeHold) => {
+        let previous = self.last_command.rate_mps;
+        let target = match (time_moved, self.health.health()) {
+            (false, _) | (true, Health::Degraded) => previous,
+            (true, Health::Nominal | Health::SafeHold) => {
                 let step = self.safe_hold_step_mps;
                 previous - previous.clamp_finite(-step, step)
             }
         };
         let length_m = self.length.length_m().unwrap_or(T::ZERO);
-        let bounds = self.hold_bounds(previous);
-        let (rate, sat) = self
+        let bounds = self.bounds(None, previous);
+        let (rate_mps, sat) = self
             .envelope
             .limit_request(target, previous, length_m, dt, &bounds);
-        flags.set(sat.0 & (Flags::LENGTH_LIMITED | Flags::TENSION_LIMITED));
-        self.last_rate_cmd_mps = rate;
+        let mut flags = Flags(sat.0 & (Flags::LENGTH_LIMITED | Flags::TENSION_LIMITED));
+        flags.set(Flags::SAFE_ACTION);
         let mu3 = self.cfg.masses.mu3_and_slope(length_m).0;
-        let x_rate = self.existence.normalised_rate(mu3, length_m, rate);
-        let accel_mps2 = (rate - previous) / dt;
-        let margin = self.equilibrium_margin(x_rate);
+        Decided {
+            command: Command {
+                rate_mps,
+                accel_mps2: (rate_mps - previous) / dt,
+            },
+            length_m,
+            mu3,
+            normalised_rate: self.existence.normalised_rate(mu3, length_m, rate_mps),
+            alpha_ref_rad,
+            blend_weight: self.sequencer.carry_blend_to(now).weight,
+            law: LawParts {
+                law_rate_mps: T::ZERO,
+                ref_rate_radps: T::ZERO,
+                delta_rad: T::ZERO,
+                delta_rate_radps: T::ZERO,
+            },
+            flags,
+            fault,
+        }
+    }
+
+    /// Report the step at `tick` ([`Controller::output`]): the command becomes the last command
+    /// (and, flying on the estimator, the drive of its next prediction), its place in the
+    /// existence region (Eq. 13), and the events of what changed since the last report.
+    #[inline(always)]
+    fn report(&mut self, tick: u32, d: &Decided<T>) {
+        self.last_command = d.command;
+        let margin = self.equilibrium_margin(d.normalised_rate);
+        let mut flags = d.flags;
         flags.set_if(margin < T::ZERO, Flags::NO_EQUILIBRIUM);
-        let nis = self.commanded(length_m, accel_mps2, mu3);
+        let nis = self.estimation.as_mut().and_then(|est| {
+            est.end_step(Commanded {
+                length_m: d.length_m,
+                rate_mps: d.command.rate_mps,
+                accel_mps2: d.command.accel_mps2,
+                mu3: d.mu3,
+            })
+        });
+        let now = Reported {
+            health: self.health.health(),
+            phase: self.sequencer.phase(),
+            fault: d.fault,
+            blend_restarts: self.sequencer.blend_restarts(),
+            stalled: self.sequencer.stalled(),
+            tension_limited: flags.contains(Flags::TENSION_LIMITED),
+        };
+        flags.set(self.record_changes(tick, now));
+        let law = &d.law;
         self.out = Output {
             tick,
-            phase: self.sequencer.phase(),
-            health: self.health.health(),
-            rate_cmd_mps: rate,
-            accel_cmd_mps2: accel_mps2,
-            law_rate_mps: T::ZERO,
-            blend_weight: self.sequencer.blend(now).weight,
-            alpha_ref_rad,
-            alpha_ref_rate_radps: T::ZERO,
-            delta_rad: T::ZERO,
-            delta_rate_radps: T::ZERO,
-            length_estimate_m: length_m,
+            phase: now.phase,
+            health: now.health,
+            rate_cmd_mps: d.command.rate_mps,
+            accel_cmd_mps2: d.command.accel_mps2,
+            law_rate_mps: law.law_rate_mps,
+            blend_weight: d.blend_weight,
+            alpha_ref_rad: d.alpha_ref_rad,
+            alpha_ref_rate_radps: law.ref_rate_radps,
+            delta_rad: law.delta_rad,
+            delta_rate_radps: law.delta_rate_radps,
+            length_estimate_m: d.length_m,
             equilibrium_margin: margin,
             nis,
             flags,
-            fault,
+            fault: d.fault,
         };
     }
 
-    /// The protection's bounds of a step in which the law did not run (a hold: the model is
-    /// stale, the free tension the load cell's own); none without a protection.
-    fn hold_bounds(&mut self, previous_mps: T) -> Bounds<T> {
-        let dt = self.cfg.period_s;
-        match &mut self.protection {
-            Some(p) => p.bounds(None, previous_mps, dt),
-            None => Bounds::none(),
+    /// The events of what changed from the last report to `now`, in this order: health,
+    /// phase, a new fault, a blend restart, a stall, the tension bound beginning to act. Returns
+    /// the flags that say so in the output ([`Flags::HEALTH_CHANGED`],
+    /// [`Flags::PHASE_CHANGED`], [`Flags::BLEND_RESTART`], [`Flags::NO_PROGRESS`]).
+    fn record_changes(&mut self, tick: u32, now: Reported) -> u32 {
+        let mut flags = Flags::default();
+        if now == self.reported {
+            flags.set_if(now.stalled, Flags::NO_PROGRESS);
+            return flags.0;
         }
+        let last = core::mem::replace(&mut self.reported, now);
+        let mut record = |kind| self.events.push(Event { tick, kind });
+        if now.health != last.health {
+            flags.set(Flags::HEALTH_CHANGED);
+            record(EventKind::Health {
+                from: last.health,
+                to: now.health,
+            });
+        }
+        if now.phase != last.phase {
+            flags.set(Flags::PHASE_CHANGED);
+            record(EventKind::Phase(now.phase));
+        }
+        if let Some(f) = now.fault.filter(|_| now.fault != last.fault) {
+            record(EventKind::Fault(f));
+        }
+        if now.blend_restarts != last.blend_restarts {
+            flags.set(Flags::BLEND_RESTART);
+            record(EventKind::BlendRestart);
+        }
+        if now.stalled {
+            flags.set(Flags::NO_PROGRESS);
+            if !last.stalled {
+                record(EventKind::NoProgress(now.phase));
+            }
+        }
+        if now.tension_limited && !last.tension_limited {
+            record(EventKind::TensionLimited);
+        }
+        flags.0
     }
 
     /// The Eq. 13 whole-orbit margin of a command whose normalised rate (Eq. 7) is `x`:
@@ -621,79 +833,6 @@ impl<T: Real> Controller<T> {
         } else {
             lowest
         }
-    }
-
-    /// Records a step's events, in this order: health change, phase change, new fault, blend
-    /// restart, the tension bound beginning to act. A quiet step (the common case) records
-    /// nothing.
-    // Inlined into the step (a quiet step's checks without a call): 8 instructions less on the
-    // mission's worst step (scripts/bench-target: 558 → 550). The changes are read from the
-    // step's flags, each set where its change happened (health, phase, blend restart, a safe
-    // action for a fault): a quiet step is one test of its flags where comparing the health,
-    // phase, fault and tension limit with the last step's took 23 instructions (mission
-    // median/worst 805/828 → 788/823; the phase's events recorded by the sequencer where it
-    // changes instead: 795/828). A step with the sequencer's events alone (a new phase, a
-    // blend restart) skips the fault and tension comparisons: worst 823 → 813.
-    #[inline(always)]
-    fn record_events(&mut self) {
-        let out = &self.out;
-        let flags = out.flags;
-        let eventful = Flags::HEALTH_CHANGED
-            | Flags::PHASE_CHANGED
-            | Flags::BLEND_RESTART
-            | Flags::SAFE_ACTION
-            | Flags::TENSION_LIMITED;
-        if flags.0 & eventful == 0 {
-            // No fault without a safe action, no tension limit: both end here.
-            debug_assert!(out.health == self.last_health && out.fault.is_none());
-            self.last_fault = None;
-            self.last_tension_limited = false;
-            return;
-        }
-        let tick = out.tick;
-        if flags.0 & (Flags::HEALTH_CHANGED | Flags::SAFE_ACTION | Flags::TENSION_LIMITED) == 0 {
-            // The sequencer's changes alone: a new phase, a blend restart.
-            self.last_fault = None;
-            self.last_tension_limited = false;
-            if flags.contains(Flags::PHASE_CHANGED) {
-                let kind = EventKind::Phase(out.phase);
-                self.events.push(Event { tick, kind });
-            }
-            if flags.contains(Flags::BLEND_RESTART) {
-                let kind = EventKind::BlendRestart;
-                self.events.push(Event { tick, kind });
-            }
-            return;
-        }
-        if flags.contains(Flags::HEALTH_CHANGED) {
-            let kind = EventKind::Health {
-                from: self.last_health,
-                to: out.health,
-            };
-            self.last_health = out.health;
-            self.events.push(Event { tick, kind });
-        }
-        if flags.contains(Flags::PHASE_CHANGED) {
-            let kind = EventKind::Phase(out.phase);
-            self.events.push(Event { tick, kind });
-        }
-        if let Some(f) = out.fault {
-            if out.fault != self.last_fault {
-                let kind = EventKind::Fault(f);
-                self.events.push(Event { tick, kind });
-            }
-        }
-        self.last_fault = out.fault;
-        if flags.contains(Flags::BLEND_RESTART) {
-            let kind = EventKind::BlendRestart;
-            self.events.push(Event { tick, kind });
-        }
-        let tension_limited = flags.contains(Flags::TENSION_LIMITED);
-        if tension_limited && !self.last_tension_limited {
-            let kind = EventKind::TensionLimited;
-            self.events.push(Event { tick, kind });
-        }
-        self.last_tension_limited = tension_limited;
     }
 }
 

@@ -62,114 +62,13 @@
 //! the discrete braking staircase is then exact for the drive: the room shrinks by u Δt per
 //! period, as the staircase assumes.
 
-use crate::config::{positive, ConfigError, Rule};
+use crate::config::{ProtectionConfig, MAX_PLAUSIBLE_TENSION_N};
+use crate::envelope::Bounds;
 use crate::mass::MassModel;
 use crate::real::Real;
 
-/// The protection's parameters (`Config::protection`; `None` there: the paper's controller,
-/// no protection).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ProtectionConfig<T> {
-    /// T_min, the least tension the command keeps at the reel, N (≥ 0).
-    pub min_tension_n: T,
-    /// T_max, the most tension the command allows at the reel, N (> T_min).
-    pub max_tension_n: T,
-    /// τ_f, the time constant over which the load cell corrects the free-tension model, s
-    /// (at least the control period).
-    pub tension_filter_s: T,
-    /// τ, the reel drive's first-order lag, s (0: the drive follows the command).
-    pub drive_lag_s: T,
-    /// The resolution of the encoder's measured mean rate, m/s: one count per period
-    /// (2πr/N/Δt). A measured rate within it of the drive model's mean rate is the count's
-    /// rounding, not the drive's motion, and does not correct the model; beyond it the model is
-    /// corrected by the excess only. 0: every measured rate is taken as it is; a resolution
-    /// larger than any rate leaves the drive to the model alone (no upper bound is needed).
-    pub rate_resolution_mps: T,
-}
-
-impl<T: Real> ProtectionConfig<T> {
-    /// Defaults for a real reel: T_min = 2 mN (docs/equations.md §14: 10 mN winds the paper's
-    /// release back to docking, 5 mN deploys), T_max = 50 N (4× the mission's nominal peak),
-    /// τ_f = 3600 s (a load cell of σ = 0.1 N then corrects the model to 1.2 mN), no drive lag.
-    pub fn default_for_period() -> Self {
-        Self {
-            min_tension_n: T::from_f64(2e-3),
-            max_tension_n: T::from_f64(50.0),
-            tension_filter_s: T::from_f64(3600.0),
-            drive_lag_s: T::ZERO,
-            rate_resolution_mps: T::ZERO,
-        }
-    }
-
-    /// Checks the parameters against the control period `period_s`.
-    pub fn validate(&self, period_s: T) -> Result<(), ConfigError> {
-        crate::config::at_least("protection.min_tension_n", self.min_tension_n, T::ZERO)?;
-        crate::config::above(
-            "protection.max_tension_n",
-            self.max_tension_n,
-            self.min_tension_n,
-        )?;
-        positive("protection.tension_filter_s", self.tension_filter_s)?;
-        if self.tension_filter_s < period_s {
-            return Err(ConfigError::new(
-                "protection.tension_filter_s",
-                self.tension_filter_s,
-                Rule::BelowMinimum,
-            ));
-        }
-        crate::config::at_least("protection.drive_lag_s", self.drive_lag_s, T::ZERO)?;
-        crate::config::at_least(
-            "protection.rate_resolution_mps",
-            self.rate_resolution_mps,
-            T::ZERO,
-        )?;
-        if self.max_tension_n > T::from_f64(MAX_PLAUSIBLE_TENSION_N) {
-            return Err(ConfigError::new(
-                "protection.max_tension_n",
-                self.max_tension_n,
-                Rule::TooLarge,
-            ));
-        }
-        Ok(())
-    }
-}
-
-/// A tension reading beyond ± this is a sensor fault, not a tether (N): it is not used.
-pub const MAX_PLAUSIBLE_TENSION_N: f64 = 1e5;
-
 /// A measured reel rate beyond this many times the envelope's rate limit is not used.
 const PLAUSIBLE_RATE_FACTOR: f64 = 2.0;
-
-/// What the envelope needs from the protection at one step.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Bounds<T> {
-    /// The commands the tether carries, [lowest, highest], m/s, from the tension bound (None:
-    /// no tension sample, or no protection). The envelope keeps its acceleration limit over it.
-    pub(crate) tension_rate_mps: Option<(T, T)>,
-    /// The commanded acceleration the tether carries, [lowest, highest], m/s² (the bound on
-    /// Eq. 30's reported value; the drive's acceleration itself when it follows the command).
-    pub(crate) tension_accel_mps2: Option<(T, T)>,
-    /// How far the drive runs toward the spool end beyond the commands, m (τ·max(v, 0)).
-    pub(crate) overrun_out_m: T,
-    /// How far the drive runs toward docking beyond the commands, m (τ·max(−v, 0)).
-    pub(crate) overrun_in_m: T,
-    /// The share of the acceleration limit the braking staircase toward a length limit uses:
-    /// (1 − e^{−h})/h with a lag (the drive's peak acceleration is then the limit), else 1.
-    pub(crate) braking_fraction: T,
-}
-
-impl<T: Real> Bounds<T> {
-    /// Nothing beyond the envelope (no protection configured).
-    pub(crate) fn none() -> Self {
-        Self {
-            tension_rate_mps: None,
-            tension_accel_mps2: None,
-            overrun_out_m: T::ZERO,
-            overrun_in_m: T::ZERO,
-            braking_fraction: T::ONE,
-        }
-    }
-}
 
 /// The state of Eq. 5a's free tension the model needs, at the law's step.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -311,9 +210,7 @@ impl<T: Real> Protection<T> {
     /// acceleration was `accel_cmd_mps2`) for `elapsed_ticks` periods; `measured_rate_mps` is
     /// the encoder's mean rate over the last period and `tension_n` the load cell's sample, if
     /// any (kept for this step's [`Protection::bounds`]).
-    // Out of line: an unprotected step only tests the Option (scripts/bench-target, flight
-    // config without protection, before main's budget round: mission median/worst 1043/1083
-    // inlined, 1013/1048 out of line).
+    // Out of line, as `bounds`.
     #[inline(never)]
     pub(crate) fn advance(
         &mut self,
@@ -372,7 +269,9 @@ impl<T: Real> Protection<T> {
     /// The bounds of this step, once per step (the load cell's sample of [`Protection::advance`]
     /// is used once). `model` is the law's state (None when the law did not run: the last
     /// model value stands in).
-    // Out of line, as `advance`.
+    // Out of line: an unprotected step (the flight configuration) then only tests the Option
+    // and keeps the envelope's bounds constant, which holds the outer step inside its ceiling
+    // (scripts/bench-target).
     #[inline(never)]
     pub(crate) fn bounds(
         &mut self,

@@ -13,7 +13,7 @@
 //! closer to it (a 5° α bias leaves the paper's retrieval at 2 364 m for ever, HZ-14) is
 //! detected: no new closest approach by [`Config::keep_capture_m`] within
 //! [`PROGRESS_TIME_CONSTANTS`] × the slowest time constant of the stage's loop (the Eq. 28
-//! envelope decay 2/k1, the Eq. 29 blend 1/c) is reported as [`Progress::Stalled`] (the
+//! envelope decay 2/k1, the Eq. 29 blend 1/c) is reported as stalled (the
 //! controller's `NO_PROGRESS` flag and event). The watch restarts with each blend restart
 //! (stage start, recovery) and each phase.
 
@@ -22,24 +22,12 @@ use crate::law::Blend;
 use crate::real::Real;
 use crate::schedule::{LibratingReference, PreparedBand, Reference};
 
-use super::output::{Flags, Phase};
+use super::output::Phase;
 
 /// The progress window, in time constants of the stage's loop (see the module docs): long
 /// enough that the exponential approach of the paper's phases to their keep lengths always
 /// gains the capture distance within it.
 pub const PROGRESS_TIME_CONSTANTS: f64 = 5.0;
-
-/// Whether the phase is getting closer to its keep length.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Progress {
-    /// Closer within the window (or a phase without a target length).
-    OnTrack,
-    /// No closer for longer than the window.
-    Stalled {
-        /// The stall was found at this step.
-        first: bool,
-    },
-}
 
 /// The closest approach of the current phase to its keep length.
 #[derive(Clone, Copy, Debug)]
@@ -65,9 +53,10 @@ enum Stage2Start {
     Begun,
 }
 
-/// The Eq. 29 blend of the current stage since it (re)started.
+/// The Eq. 29 blend of the current stage since it (re)started, carried forward one period at
+/// a time ([`CarriedBlend::carry_to`]).
 #[derive(Clone, Copy, Debug)]
-struct BlendStart<T> {
+struct CarriedBlend<T> {
     /// The tick it (re)started at.
     tick: u32,
     /// l̇0: the rate it started from, m/s.
@@ -76,7 +65,7 @@ struct BlendStart<T> {
     decay_rate_per_s: T,
     /// The stage's constants per period.
     per_tick: BlendPerTick<T>,
-    /// The blend at the last tick it was asked for, and that tick.
+    /// The blend at the last tick it was carried to, and that tick.
     last: (u32, Blend<T>),
     /// What E at that tick lacks of its value carried one period at a time: the roundings
     /// of the carried E, kept apart (compensated summation: Kahan, Higham §4.3).
@@ -106,7 +95,7 @@ impl<T: Real> BlendPerTick<T> {
     }
 }
 
-impl<T: Real> BlendStart<T> {
+impl<T: Real> CarriedBlend<T> {
     /// The blend of a stage with `per_tick`, (re)starting at `tick` from `initial_rate_mps`:
     /// E = 1.
     fn new(tick: u32, initial_rate_mps: T, decay_rate_per_s: T, per_tick: BlendPerTick<T>) -> Self {
@@ -119,6 +108,43 @@ impl<T: Real> BlendStart<T> {
             weight_low: T::ZERO,
         }
     }
+
+    /// Carries E forward to `tick` and returns E = e^{−cτ} and 1 − E there, τ = k·Δt the time
+    /// since the blend (re)started k ticks before (Eq. 29), each to its own relative precision
+    /// (docs/equations.md §5.2).
+    ///
+    /// One period after the last tick it was carried to (each step of a mission without
+    /// gaps), the period's decay takes the share q = 1 − e^{−cΔt} of E away: E′ = E − qE, with
+    /// the subtraction's rounding kept apart in `weight_low` and paid back the next period
+    /// (compensated summation, Kahan; Higham §4.3), so E stays within a few roundings of
+    /// e^{−cτ} however many periods it is carried, and 1 − E′ = (1 − E′_hi) − E′_lo keeps its
+    /// own precision (the first difference is exact for E′ ≥ ½). After a gap in the calls E is
+    /// worked out afresh as 2^{k·(−cΔt·log₂e)}.
+    #[inline(always)]
+    fn carry_to(&mut self, tick: u32) -> Blend<T> {
+        let (last_tick, last) = self.last;
+        let now = match tick.wrapping_sub(last_tick) {
+            0 => last,
+            1 => {
+                // E_lo·q is below the roundings of E itself: left out.
+                let taken = last.weight * self.per_tick.decayed_share - self.weight_low;
+                let weight = last.weight - taken;
+                // Exact (Fast2Sum: E ≥ taken): what the subtraction rounded away.
+                self.weight_low = (last.weight - weight) - taken;
+                Blend {
+                    weight,
+                    complement: (T::ONE - weight) - self.weight_low,
+                }
+            }
+            _ => {
+                let k = T::from_u32(tick.wrapping_sub(self.tick));
+                self.weight_low = T::ZERO;
+                Blend::from_log2(self.per_tick.log2_weight * k)
+            }
+        };
+        self.last = (tick, now);
+        now
+    }
 }
 
 /// The sequencer's state and what it needs of the configuration.
@@ -130,7 +156,9 @@ pub(super) struct Sequencer<T> {
     /// The tick the current stage began at.
     stage_start_tick: u32,
     stage2: Stage2Start,
-    blend: BlendStart<T>,
+    blend: CarriedBlend<T>,
+    /// How many times a blend has (re)started (wrapping): a restart is an event.
+    blend_restarts: u32,
     /// The Eq. 34 schedule of stage 1, prepared.
     stage1_band: PreparedBand<T>,
     /// The Eq. 35 schedule of stage 2, prepared.
@@ -179,12 +207,13 @@ impl<T: Real> Sequencer<T> {
                 Some(tick) => Stage2Start::At(tick),
                 None => Stage2Start::OnRequest,
             },
-            blend: BlendStart::new(
+            blend: CarriedBlend::new(
                 0,
                 cfg.initial_rate_mps,
                 decay_rate_per_s[0],
                 blend_per_tick[0],
             ),
+            blend_restarts: 0,
             stage1_band: cfg.stage1.schedule.prepare(),
             stage2_band: cfg.stage2.schedule.prepare(),
             librating: LibratingReference::new(&cfg.orbit),
@@ -221,15 +250,15 @@ impl<T: Real> Sequencer<T> {
     }
 
     /// Begins stage 1 at the first step: its blend starts from l̇0.
-    pub(super) fn begin_stage1(&mut self, tick: u32, flags: &mut Flags) {
+    pub(super) fn begin_stage1(&mut self, tick: u32) {
         self.mission_start_tick = tick;
         self.stage_start_tick = tick;
-        self.restart_blend(tick, self.blend.initial_rate_mps, flags);
+        self.restart_blend(tick, self.blend.initial_rate_mps);
     }
 
     /// Begins stage 2 if it is due at `tick` (at its tick or on request): α_r slews, and the
     /// blend restarts from the current rate `rate_mps`.
-    pub(super) fn begin_stage2_if_due(&mut self, tick: u32, rate_mps: T, flags: &mut Flags) {
+    pub(super) fn begin_stage2_if_due(&mut self, tick: u32, rate_mps: T) {
         let due = match self.stage2 {
             // Mission time: ticks since the first step (modulo 2³², as every tick difference).
             Stage2Start::At(start) => tick.wrapping_sub(self.mission_start_tick) >= start,
@@ -240,63 +269,33 @@ impl<T: Real> Sequencer<T> {
             self.stage2 = Stage2Start::Begun;
             self.stage_start_tick = tick;
             self.phase = Phase::Slew;
-            flags.set(Flags::PHASE_CHANGED);
-            self.restart_blend(tick, rate_mps, flags);
+            self.restart_blend(tick, rate_mps);
         }
     }
 
     /// Restarts the current stage's Eq. 29 blend at `tick` from `rate_mps`.
-    pub(super) fn restart_blend(&mut self, tick: u32, rate_mps: T, flags: &mut Flags) {
+    pub(super) fn restart_blend(&mut self, tick: u32, rate_mps: T) {
         let stage = self.stage();
-        self.blend = BlendStart::new(
+        self.blend = CarriedBlend::new(
             tick,
             rate_mps,
             self.decay_rate_per_s[stage],
             self.blend_per_tick[stage],
         );
         self.approach = None;
-        flags.set(Flags::BLEND_RESTART);
+        self.blend_restarts = self.blend_restarts.wrapping_add(1);
     }
 
-    /// E = e^{−cτ} and 1 − E at `tick`, τ = k·Δt the time since the blend (re)started k ticks
-    /// before (Eq. 29), each to its own relative precision (docs/equations.md §5.2). `tick` is
-    /// an accepted tick: at or after the start, modulo 2³² (see `clock`), and at or after the
-    /// last one asked for.
-    ///
-    /// One period after the last tick asked for (each step of a mission without gaps), the
-    /// period's decay takes the share q = 1 − e^{−cΔt} of E away: E′ = E − qE, with the
-    /// subtraction's rounding kept apart and paid back the next period (compensated
-    /// summation), so E stays within a few roundings of e^{−cτ} however many periods it is
-    /// carried, and 1 − E′ = (1 − E′_hi) − E′_lo keeps its own precision (the first
-    /// difference is exact for E′ ≥ ½). After a gap in the calls E is worked out afresh as
-    /// 2^{k·(−cΔt·log₂e)}.
-    // One period as a product and five sums, where the exponential took 35 instructions a step
-    // (scripts/bench-target, mission median/worst 833/855 → 805/828).
-    #[inline(always)]
-    pub(super) fn blend(&mut self, tick: u32) -> Blend<T> {
-        let b = &mut self.blend;
-        let (last_tick, last) = b.last;
-        let now = match tick.wrapping_sub(last_tick) {
-            0 => last,
-            1 => {
-                // E_lo·q is below the roundings of E itself: left out.
-                let taken = last.weight * b.per_tick.decayed_share - b.weight_low;
-                let weight = last.weight - taken;
-                // Exact (Fast2Sum: E ≥ taken): what the subtraction rounded away.
-                b.weight_low = (last.weight - weight) - taken;
-                Blend {
-                    weight,
-                    complement: (T::ONE - weight) - b.weight_low,
-                }
-            }
-            _ => {
-                let k = T::from_u32(tick.wrapping_sub(b.tick));
-                b.weight_low = T::ZERO;
-                Blend::from_log2(b.per_tick.log2_weight * k)
-            }
-        };
-        b.last = (tick, now);
-        now
+    /// How many times a blend has (re)started (wrapping).
+    pub(super) fn blend_restarts(&self) -> u32 {
+        self.blend_restarts
+    }
+
+    /// Carries the current stage's Eq. 29 blend forward to `tick` and returns E = e^{−cτ}
+    /// and 1 − E there ([`CarriedBlend::carry_to`]). `tick` is an accepted tick: at or after
+    /// the start, modulo 2³² (see `clock`), and at or after the last one carried to.
+    pub(super) fn carry_blend_to(&mut self, tick: u32) -> Blend<T> {
+        self.blend.carry_to(tick)
     }
 
     /// l̇0 of the current blend, m/s.
@@ -311,8 +310,8 @@ impl<T: Real> Sequencer<T> {
 
     /// α_r and its derivatives at this tick and length: Eq. 34 in stage 1; in stage 2, the
     /// slew from the stage's start until it first meets Eq. 35 ([`Phase::Slew`]), then Eq. 35.
-    // Inlined into both callers (the step and the safe action): with `blend`, 37 instructions
-    // less on the mission's worst step (scripts/bench-target: 580 → 543).
+    // Inlined into the step: out of line the outer step exceeded its ceiling
+    // (scripts/bench-target).
     #[inline(always)]
     pub(super) fn reference(&self, tick: u32, length_m: T) -> Reference<T> {
         let band = match self.phase {
@@ -337,6 +336,7 @@ impl<T: Real> Sequencer<T> {
     /// [`Sequencer::reference`] at true anomaly θ (rad): on an eccentric orbit, with the forced
     /// libration and the orbit's terms (docs/equations.md §16), and with NaN orbit terms when θ
     /// is not finite (the law then faults: the safe action); on a circular one, the same.
+    // Inlined, as `reference`.
     #[inline(always)]
     pub(super) fn reference_at(&self, tick: u32, length_m: T, true_anomaly_rad: T) -> Reference<T> {
         let base = self.reference(tick, length_m);
@@ -352,55 +352,42 @@ impl<T: Real> Sequencer<T> {
     /// the stage-1 keep length (less the capture), Slew becomes Retrieve once α_r meets the
     /// Eq. 35 schedule (for good), Retrieve becomes Keep2 at the stage-2 keep length (plus the
     /// capture). The keep phases last until the next stage or the end.
-    // One `match` on the phase for both (rather than one to advance it, one to watch it):
-    // 5 instructions less on the mission's worst step (scripts/bench-target: 565 → 560).
-    pub(super) fn advance_phase(
-        &mut self,
-        tick: u32,
-        length_m: T,
-        slewing: bool,
-        flags: &mut Flags,
-    ) -> Progress {
+    pub(super) fn advance_phase(&mut self, tick: u32, length_m: T, slewing: bool) {
         match self.phase {
-            Phase::Deploy if length_m >= self.keep1_entry_m => self.enter(Phase::Keep1, flags),
+            Phase::Deploy if length_m >= self.keep1_entry_m => self.enter(Phase::Keep1),
             Phase::Deploy => {
                 let distance_m = self.keep1_entry_m - length_m;
                 self.watch(tick, distance_m, self.progress_window_ticks[0])
             }
             Phase::Slew if !slewing => {
-                self.enter(Phase::Retrieve, flags);
+                self.enter(Phase::Retrieve);
                 let distance_m = length_m - self.keep2_entry_m;
                 self.watch(tick, distance_m, self.progress_window_ticks[1])
             }
-            Phase::Retrieve if length_m <= self.keep2_entry_m => self.enter(Phase::Keep2, flags),
+            Phase::Retrieve if length_m <= self.keep2_entry_m => self.enter(Phase::Keep2),
             Phase::Retrieve => {
                 let distance_m = length_m - self.keep2_entry_m;
                 self.watch(tick, distance_m, self.progress_window_ticks[1])
             }
-            Phase::Keep1 | Phase::Slew | Phase::Keep2 => Progress::OnTrack,
+            Phase::Keep1 | Phase::Slew | Phase::Keep2 => {}
         }
     }
 
-    /// A new phase ([`Flags::PHASE_CHANGED`]): its progress watch starts afresh (a keep phase
-    /// has none).
-    fn enter(&mut self, phase: Phase, flags: &mut Flags) -> Progress {
+    /// A new phase: its progress watch starts afresh (a keep phase has none).
+    fn enter(&mut self, phase: Phase) {
         self.phase = phase;
-        flags.set(Flags::PHASE_CHANGED);
         self.approach = None;
-        Progress::OnTrack
     }
 
-    /// The progress of a phase `distance_m` from its keep length at `tick`: stalled when no
-    /// new closest approach (by the capture distance) came within `window_ticks`.
-    fn watch(&mut self, tick: u32, distance_m: T, window_ticks: u32) -> Progress {
+    /// Watches the progress of a phase `distance_m` from its keep length at `tick`: stalled
+    /// ([`Sequencer::stalled`]) when no new closest approach (by the capture distance) came
+    /// within `window_ticks`.
+    fn watch(&mut self, tick: u32, distance_m: T, window_ticks: u32) {
         match &mut self.approach {
             Some(a) if distance_m > a.closest_m - self.min_progress_m => {
-                if tick.wrapping_sub(a.tick) <= window_ticks {
-                    return Progress::OnTrack;
+                if tick.wrapping_sub(a.tick) > window_ticks {
+                    a.stalled = true;
                 }
-                let first = !a.stalled;
-                a.stalled = true;
-                Progress::Stalled { first }
             }
             _ => {
                 self.approach = Some(Approach {
@@ -408,7 +395,6 @@ impl<T: Real> Sequencer<T> {
                     tick,
                     stalled: false,
                 });
-                Progress::OnTrack
             }
         }
     }
@@ -438,12 +424,11 @@ mod tests {
         for (stage, c) in rates.map(f64::from).into_iter().enumerate() {
             let mut s = Sequencer::new(&cfg);
             let start = u32::MAX - 10;
-            let mut flags = Flags::default();
             s.phase = [Phase::Deploy, Phase::Retrieve][stage];
-            s.restart_blend(start, 0.0, &mut flags);
+            s.restart_blend(start, 0.0);
             let (mut worst_weight, mut worst_complement) = (0.0_f64, 0.0_f64);
             for k in 0..100_000_u32 {
-                let b = s.blend(start.wrapping_add(k));
+                let b = s.carry_blend_to(start.wrapping_add(k));
                 let tau_s = f64::from(k) * f64::from(cfg.period_s);
                 let weight = (-c * tau_s).exp();
                 // The per-period constant's rounding (relative 2⁻²⁴ of q) adds up to cτ·2⁻²⁴
@@ -472,24 +457,23 @@ mod tests {
     fn after_a_gap_the_blend_is_worked_out_afresh_from_its_start() {
         let cfg = Config::<f32>::paper();
         let mut s = Sequencer::new(&cfg);
-        let mut flags = Flags::default();
-        s.restart_blend(100, 0.0, &mut flags);
+        s.restart_blend(100, 0.0);
         for tick in 100..=600 {
-            s.blend(tick);
+            s.carry_blend_to(tick);
         }
         // 600 → 900 (a gap of 300 periods), then the same tick again.
-        let after_gap = s.blend(900);
+        let after_gap = s.carry_blend_to(900);
         let afresh = Blend::<f32>::from_log2(s.blend.per_tick.log2_weight * 800.0);
         assert_eq!(after_gap.weight, afresh.weight);
         assert_eq!(after_gap.complement, afresh.complement);
-        assert_eq!(s.blend(900).weight, afresh.weight);
+        assert_eq!(s.carry_blend_to(900).weight, afresh.weight);
         // And the next period carries on from it.
-        let next = s.blend(901);
+        let next = s.carry_blend_to(901);
         let exact = (-f64::from(cfg.stage1.decay_rate_per_s) * 801.0).exp();
         assert!(ulps(next.weight, exact) <= 4.0);
         // A restart is E = 1 at its tick.
-        s.restart_blend(901, 0.0, &mut flags);
-        let restarted = s.blend(901);
+        s.restart_blend(901, 0.0);
+        let restarted = s.carry_blend_to(901);
         assert_eq!((restarted.weight, restarted.complement), (1.0, 0.0));
     }
 }

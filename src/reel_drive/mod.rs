@@ -64,8 +64,6 @@ pub use config::{
 };
 pub use encoder::{CountFault, Odometer};
 
-use crate::controller::{Health, Output};
-
 /// The rate command of one law period, as the inner loop needs it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -76,16 +74,6 @@ pub struct RateCommand {
     pub accel_mps2: f32,
     /// The outer controller is in safe hold: the brake may engage but not release.
     pub safe_hold: bool,
-}
-
-impl From<&Output<f32>> for RateCommand {
-    fn from(o: &Output<f32>) -> Self {
-        Self {
-            rate_mps: o.rate_cmd_mps,
-            accel_mps2: o.accel_cmd_mps2,
-            safe_hold: o.health == Health::SafeHold,
-        }
-    }
 }
 
 /// One inner tick's sensor readings.
