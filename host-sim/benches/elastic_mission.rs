@@ -1,8 +1,10 @@
 //! The whole 20-hour paper mission on the truth model (`scenarios/paper-elastic.toml`: 0.5 mm
 //! Dyneema in 20 beads at 30 km, the motor reel, J2 and drag; 72 000 control periods of the
 //! f32 flight controller), as `tss-sim run` computes it (`tss_sim::sim::run`), without writing
-//! any output; and, for where the time goes, one control period of the elastic plant alone at
-//! 30 km (20 beads) and at 2 km (1 bead).
+//! any output, at three steps side by side: the scenario's (`plant.courant = 2`), the former
+//! default (`plant.courant = 1`) and a quarter of the scenario's (`plant.courant = 0.5`, the
+//! convergence reference of docs/truth-model.md); and, for where the time goes, one control
+//! period of the elastic plant alone at 30 km (20 beads) and at 2 km (no bead).
 //!
 //! `cargo bench -p tss-sim --bench elastic_mission`. Figures only, no assertions.
 
@@ -17,9 +19,13 @@ fn bench(c: &mut Criterion) {
     let sc = Scenario::load(&path, &[]).unwrap();
     let mut g = c.benchmark_group("elastic_mission");
     g.sample_size(10);
-    g.bench_function("sim_run_20h", |b| {
-        b.iter(|| tss_sim::sim::run(&sc, &[], &mut |_| {}).unwrap())
-    });
+    for courant in [sc.plant.courant, 1.0, 0.5] {
+        let sets = [format!("plant.courant={courant}")];
+        let sc = Scenario::load(&path, &sets).unwrap();
+        g.bench_function(format!("sim_run_20h_courant_{courant}"), |b| {
+            b.iter(|| tss_sim::sim::run(&sc, &[], &mut |_| {}).unwrap())
+        });
+    }
     for length_m in [30_000.0, 2_000.0] {
         let plant = ElasticPlant::new(
             ElasticParams::from(&sc),

@@ -726,6 +726,69 @@ fn refining_the_beads_converges_the_keeps_mean_length() {
     );
 }
 
+/// Convergence in the step (long: three 20-h missions, a few seconds each in release; `cargo
+/// test --release -p tss-sim --test truth_model -- --ignored`): paper-elastic at its default
+/// `plant.courant = 2`, at 1, and at a quarter of the default step (0.5, the reference).
+///
+/// What the default guarantees: up to the tether's first slack episode (18 540 s, in the 30-km
+/// keep) the histories converge pointwise at RK4's order: l_u within 3 m and the tension at
+/// the reel within 1.5 N of the reference at courant 2 (the fastest, numerically damped modes
+/// are the beads' 7.3 rad/s, ωh = 1.8), ten times closer at courant 1 (the error falls by
+/// 2⁴ per halving). From the first slack–snap on, the histories part (a free flight ended by a
+/// snap is sensitive to its start: 200–1 100 m apart at any two steps, as between two runs
+/// differing in the 12th digit): only statistics are converged quantities, and the share of
+/// samples slack agrees within 2 points.
+#[test]
+#[ignore = "three 20-hour missions"]
+fn the_default_step_converges_up_to_the_first_slack() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper-elastic.toml");
+    let fly = |courant: f64| {
+        let sets = [format!("plant.courant={courant}")];
+        let sc = Scenario::load(&path, &sets).unwrap();
+        tss_sim::sim::run(&sc, &[], &mut |_| {}).unwrap()
+    };
+    let default = Scenario::load(&path, &[]).unwrap().plant.courant;
+    assert_eq!(default, 2.0);
+    let reference = fly(default / 4.0);
+    let first_slack = reference
+        .samples
+        .iter()
+        .find(|s| s.t_s > 0.0 && s.tension_n <= 0.0)
+        .unwrap()
+        .t_s;
+    let slack_share = |h: &tss_sim::history::History| {
+        h.samples.iter().filter(|s| s.tension_n <= 0.0).count() as f64 / h.samples.len() as f64
+    };
+    let mut errors = Vec::new();
+    for courant in [default, default / 2.0] {
+        let h = fly(courant);
+        let before = h
+            .samples
+            .iter()
+            .zip(&reference.samples)
+            .filter(|(s, _)| s.t_s < first_slack);
+        let (dl, dt) = before.fold((0.0_f64, 0.0_f64), |(dl, dt), (a, b)| {
+            (
+                dl.max((a.length_m - b.length_m).abs()),
+                dt.max((a.tension_n - b.tension_n).abs()),
+            )
+        });
+        let share = (slack_share(&h) - slack_share(&reference)).abs();
+        println!(
+            "courant {courant} vs {}: before the first slack ({first_slack} s) |Δl_u| ≤ {dl:.3} m, \
+             |ΔT| ≤ {dt:.3} N; slack share {:.3} vs {:.3}",
+            default / 4.0,
+            slack_share(&h),
+            slack_share(&reference)
+        );
+        assert!(share < 0.02, "{share}");
+        errors.push((dl, dt));
+    }
+    assert!(errors[0].0 < 3.0 && errors[0].1 < 1.5, "{:?}", errors[0]);
+    assert!(errors[1].0 < 0.3 && errors[1].1 < 0.15, "{:?}", errors[1]);
+    assert!(errors[1].0 * 8.0 < errors[0].0, "{errors:?}");
+}
+
 /// The orbit's node, rad, from the centre of mass's angular momentum h: Ω = atan2(h_x, −h_y).
 fn node_rad(p: &ElasticPlant) -> f64 {
     let (r, v) = p.centre_of_mass_state();

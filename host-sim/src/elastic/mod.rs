@@ -24,486 +24,38 @@
 //! e_r = R_c/|R_c|, e_h ∥ R_c × V_c, θ̇ = |R_c × V_c|/|R_c|².
 //!
 //! ## Integration
-//! Classical RK4 with the control period split into equal substeps. The substep count is
-//! chosen each period from the highest rate of the current configuration: for every segment
-//! √(k(1/m_a + 1/m_b)) and its damping C/L(1/m_a + 1/m_b), the drum's coupling through the reel
-//! segment, the speed loop's 2ω_b. The step keeps (rate × h) ≤ `courant` (default 1: RK4 is
-//! stable to 2.8 and damps a mode at ωh = 1 by 0.7 % per step; librations and the bounce mode
-//! sit at ωh ≪ 0.1). Topology changes (beads entering and leaving, [`tether::feed`]) and the
-//! drum's stick/slip switches happen between substeps.
+//! Classical RK4 ([`integration`]) with the control period split into equal substeps. The
+//! substep count is chosen each period from the highest rate of the current configuration: for
+//! every segment √(k(1/m_a + 1/m_b)) and its damping C/L(1/m_a + 1/m_b), the drum's coupling
+//! through the reel segment, the speed loop's closed-loop poles (a double pole at −ω_b). The
+//! step keeps (rate × h) ≤ `courant` (RK4 is stable to 2.8; docs/truth-model.md states what
+//! the scenarios' courant = 2 guarantees about convergence). Topology changes (beads entering
+//! and leaving, [`feeding::feed`]) and the drum's stick/slip switches happen between substeps.
 
 pub mod environment;
+pub mod feeding;
+mod frame;
 mod initial;
+mod integration;
+mod params;
 pub mod reel_drum;
 pub mod tether;
 
+pub use frame::Angles;
+pub use params::{
+    BodyParams, ElasticError, ElasticParams, FlightParams, InitialConditions, OrbitParams,
+    ReelModel, ReelParams, Sensing,
+};
+
 use crate::plant::{Command, ElasticObservation, Observation, Plant, SensorTruth};
 use crate::reel::{Reel, ReelSaturation};
-use environment::{air_velocity_mps, body_drag_n, cylinder_drag_n, Environment, Vec3};
+use environment::Vec3;
+use feeding::{feed, Feed};
+use frame::{direction_angles, orbit_frame, orbit_state, plane_basis};
+use integration::{motor_torque, ReelDrive, State, Workspace};
+use params::check;
 use reel_drum::{DriveFigures, DrumParams, FlightDrum, Motion};
-use tether::{Feed, Layout, TetherParams};
-use tss_reel::orbit::Orbit;
-
-/// The orbit the centre of mass starts on.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct OrbitParams {
-    /// Semi-major axis, eccentricity and μ.
-    pub orbit: Orbit<f64>,
-    /// True anomaly at t = 0, rad.
-    pub initial_true_anomaly_rad: f64,
-    /// Inclination of the orbit plane to the equator, rad (the ascending node and perigee on
-    /// the inertial x axis).
-    pub inclination_rad: f64,
-}
-
-/// The end bodies.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BodyParams {
-    /// Main satellite's initial mass m01 (with all the tether on the drum), kg.
-    pub main_initial_kg: f64,
-    /// Sub-satellite's mass m2, kg.
-    pub sub_kg: f64,
-    /// Main satellite's drag area times drag coefficient C_d·A, m².
-    pub main_drag_area_m2: f64,
-    /// Sub-satellite's C_d·A, m².
-    pub sub_drag_area_m2: f64,
-}
-
-/// How the reel's rate follows the controller's command.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ReelModel {
-    /// l̇ = the command, at once (the paper's assumption).
-    Ideal,
-    /// The first-order lag with rate and acceleration limits of `crate::reel` (its `rate_mps`
-    /// is the drive's rate at t = 0 and is overwritten with the initial rate).
-    Lag(Reel),
-    /// The drum and motor of [`reel_drum`], through its speed loop.
-    Motor(DrumParams),
-    /// The drum of [`reel_drum`] driven by the flight speed loop ([`FlightDrum`]) at its inner
-    /// rate: the plant substeps at every inner tick, the motor's torque held over it.
-    Flight(FlightParams),
-}
-
-/// The drum and the flight speed loop that drives it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FlightParams {
-    /// The drum (its `speed_bandwidth_radps` unused: the flight loop's gains fly).
-    pub drum: DrumParams,
-    /// The speed loop's inner rate, Hz (≥ 100).
-    pub inner_rate_hz: u32,
-    /// Encoder counts per drum revolution.
-    pub counts_per_rev: u32,
-    /// The law's period, s (the drive's outer period).
-    pub period_s: f64,
-}
-
-impl FlightParams {
-    /// The drive configuration the flight loop flies ([`FlightDrum::drive_config`], with this
-    /// encoder on the drum's shaft).
-    pub fn drive_config(&self) -> tss_reel::reel_drive::DriveConfig {
-        let mut cfg = FlightDrum::drive_config(&self.drum, self.inner_rate_hz, self.period_s);
-        cfg.geometry.counts_per_motor_rev = self.counts_per_rev;
-        cfg.geometry.gear_ratio = 1;
-        cfg
-    }
-}
-
-/// The reel.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ReelParams {
-    /// How the reel follows the command.
-    pub model: ReelModel,
-    /// Hold the drum still: no tether moves at the reel, and the commands are ignored.
-    pub locked: bool,
-}
-
-/// Which direction the controller's α and β describe.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Sensing {
-    /// The line from the main satellite to the sub-satellite (as in the rigid plant).
-    Line,
-    /// The tether's exit direction at the deployer (main satellite → first node).
-    Exit,
-}
-
-/// Everything the truth model needs.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ElasticParams {
-    /// The orbit of the centre of mass at t = 0.
-    pub orbit: OrbitParams,
-    /// End bodies.
-    pub bodies: BodyParams,
-    /// Tether material and discretisation.
-    pub tether: TetherParams,
-    /// Reel mechanism.
-    pub reel: ReelParams,
-    /// Gravity and atmosphere.
-    pub environment: Environment,
-    /// What the controller's angles describe.
-    pub sensing: Sensing,
-    /// Largest (rate × step) of the integration (see the module doc).
-    pub courant: f64,
-}
-
-/// The initial state, in the rigid plant's terms: straight, at its initial length, each segment
-/// stretched to the tension that motion needs (static equilibrium, `initial.rs`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct InitialConditions {
-    /// Paid-out length l(0), m.
-    pub length_m: f64,
-    /// Reel rate l̇(0), m/s (the sub-satellite moves away at this rate).
-    pub rate_mps: f64,
-    /// α(0), rad.
-    pub alpha_rad: f64,
-    /// α̇(0), rad/s.
-    pub alpha_rate_radps: f64,
-    /// β(0), rad.
-    pub beta_rad: f64,
-    /// β̇(0), rad/s.
-    pub beta_rate_radps: f64,
-}
-
-/// Why a truth model cannot be built or stepped.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ElasticError {
-    /// A parameter is out of its range.
-    #[error("elastic plant: {field} = {value} is invalid ({rule})")]
-    Invalid {
-        /// The parameter.
-        field: &'static str,
-        /// Its value.
-        value: f64,
-        /// What it must satisfy.
-        rule: &'static str,
-    },
-    /// The state stopped being finite.
-    #[error("elastic plant: the state became non-finite at t = {t_s} s")]
-    Diverged {
-        /// Time, s.
-        t_s: f64,
-    },
-}
-
-fn check(
-    field: &'static str,
-    value: f64,
-    ok: bool,
-    rule: &'static str,
-) -> Result<(), ElasticError> {
-    if ok && value.is_finite() {
-        Ok(())
-    } else {
-        Err(ElasticError::Invalid { field, value, rule })
-    }
-}
-
-impl ElasticParams {
-    /// Checks every parameter (finite, in range).
-    pub fn validate(&self) -> Result<(), ElasticError> {
-        let o = &self.orbit;
-        let a = o.orbit.semi_major_axis_m;
-        let e = o.orbit.eccentricity;
-        check("orbit.semi_major_axis_m", a, a > 0.0, "> 0")?;
-        check(
-            "orbit.eccentricity",
-            e,
-            (0.0..1.0).contains(&e),
-            "in [0, 1)",
-        )?;
-        check(
-            "orbit.mu_m3ps2",
-            o.orbit.mu_m3ps2,
-            o.orbit.mu_m3ps2 > 0.0,
-            "> 0",
-        )?;
-        check(
-            "orbit.initial_true_anomaly_rad",
-            o.initial_true_anomaly_rad,
-            true,
-            "finite",
-        )?;
-        check("orbit.inclination_rad", o.inclination_rad, true, "finite")?;
-        let b = &self.bodies;
-        check(
-            "bodies.main_initial_kg",
-            b.main_initial_kg,
-            b.main_initial_kg > 0.0,
-            "> 0",
-        )?;
-        check("bodies.sub_kg", b.sub_kg, b.sub_kg > 0.0, "> 0")?;
-        check(
-            "bodies.main_drag_area_m2",
-            b.main_drag_area_m2,
-            b.main_drag_area_m2 >= 0.0,
-            ">= 0",
-        )?;
-        check(
-            "bodies.sub_drag_area_m2",
-            b.sub_drag_area_m2,
-            b.sub_drag_area_m2 >= 0.0,
-            ">= 0",
-        )?;
-        let t = &self.tether;
-        check(
-            "tether.density_kg_per_m",
-            t.density_kg_per_m,
-            t.density_kg_per_m >= 0.0,
-            ">= 0",
-        )?;
-        check(
-            "tether.axial_stiffness_n",
-            t.axial_stiffness_n,
-            t.axial_stiffness_n > 0.0,
-            "> 0",
-        )?;
-        check(
-            "tether.damping_ns",
-            t.damping_ns,
-            t.damping_ns >= 0.0,
-            ">= 0",
-        )?;
-        check(
-            "tether.diameter_m",
-            t.diameter_m,
-            t.diameter_m >= 0.0,
-            ">= 0",
-        )?;
-        check(
-            "tether.drag_coefficient",
-            t.drag_coefficient,
-            t.drag_coefficient >= 0.0,
-            ">= 0",
-        )?;
-        check(
-            "tether.segment_length_m",
-            t.segment_length_m,
-            t.segment_length_m > 0.0,
-            "> 0",
-        )?;
-        check(
-            "tether.min_stiffness_length_m",
-            t.min_stiffness_length_m,
-            t.min_stiffness_length_m > 0.0 && t.min_stiffness_length_m <= t.segment_length_m,
-            "in (0, segment_length_m]",
-        )?;
-        match &self.reel.model {
-            ReelModel::Ideal => {}
-            ReelModel::Lag(r) => {
-                check("reel.lag_s", r.lag_s, r.lag_s >= 0.0, ">= 0")?;
-                let ok = r.max_rate_mps > 0.0 && !r.max_rate_mps.is_nan();
-                check(
-                    "reel.max_rate_mps",
-                    if ok { 1.0 } else { r.max_rate_mps },
-                    ok,
-                    "> 0",
-                )?;
-                let ok = r.max_accel_mps2 > 0.0 && !r.max_accel_mps2.is_nan();
-                check(
-                    "reel.max_accel_mps2",
-                    if ok { 1.0 } else { r.max_accel_mps2 },
-                    ok,
-                    "> 0",
-                )?;
-            }
-            ReelModel::Flight(f) => {
-                check_drum(&f.drum)?;
-                let hz = f64::from(f.inner_rate_hz);
-                check("reel.inner_rate_hz", hz, hz >= 100.0, ">= 100")?;
-                let c = f64::from(f.counts_per_rev);
-                check("reel.encoder_counts_per_rev", c, c > 0.0, "> 0")?;
-                check("period_s", f.period_s, f.period_s > 0.0, "> 0")?;
-                if f.drive_config().validate().is_err() {
-                    return Err(ElasticError::Invalid {
-                        field: "reel (flight drive configuration)",
-                        value: hz,
-                        rule: "a valid tss_reel::reel_drive::DriveConfig",
-                    });
-                }
-            }
-            ReelModel::Motor(d) => check_drum(d)?,
-        }
-        check(
-            "courant",
-            self.courant,
-            self.courant > 0.0 && self.courant <= 2.0,
-            "in (0, 2]",
-        )
-    }
-}
-
-/// The drum's parameters in range.
-fn check_drum(d: &DrumParams) -> Result<(), ElasticError> {
-    check("reel.drum_radius_m", d.radius_m, d.radius_m > 0.0, "> 0")?;
-    check(
-        "reel.inertia_kgm2",
-        d.inertia_kgm2,
-        d.inertia_kgm2 > 0.0,
-        "> 0",
-    )?;
-    check(
-        "reel.viscous_nms",
-        d.viscous_nms,
-        d.viscous_nms >= 0.0,
-        ">= 0",
-    )?;
-    check("reel.coulomb_nm", d.coulomb_nm, d.coulomb_nm >= 0.0, ">= 0")?;
-    check(
-        "reel.static_nm",
-        d.static_nm,
-        d.static_nm >= d.coulomb_nm,
-        ">= coulomb_nm",
-    )?;
-    check(
-        "reel.max_torque_nm",
-        d.max_torque_nm,
-        d.max_torque_nm > 0.0,
-        "> 0",
-    )?;
-    check("reel.brake_nm", d.brake_nm, d.brake_nm >= 0.0, ">= 0")?;
-    let w = d.speed_bandwidth_radps;
-    check("reel.speed_bandwidth_radps", w, w > 0.0, "> 0")?;
-    Ok(())
-}
-
-/// The integrated state: the reference particle, the reel, and every node relative to the
-/// reference (inertial axes). Also the shape of its time derivative.
-#[derive(Clone, Debug, Default, PartialEq)]
-struct State {
-    /// Reference particle's position R and velocity V (inertial), m, m/s.
-    r_ref: Vec3,
-    v_ref: Vec3,
-    /// Paid-out unstretched length l_u (the encoder's reading), m.
-    paid_out_m: f64,
-    /// Drum speed ω, rad/s (motor reel only).
-    drum_speed_radps: f64,
-    /// The speed loop's integral of the speed error, rad (motor reel only).
-    drum_integral_rad: f64,
-    /// Node positions ρ_i and velocities ρ̇_i relative to the reference, m, m/s.
-    pos: Vec<Vec3>,
-    vel: Vec<Vec3>,
-}
-
-impl State {
-    /// `self = y + c·k` (same node count).
-    fn set_stage(&mut self, y: &State, c: f64, k: &State) {
-        self.r_ref = y.r_ref + k.r_ref * c;
-        self.v_ref = y.v_ref + k.v_ref * c;
-        self.paid_out_m = y.paid_out_m + k.paid_out_m * c;
-        self.drum_speed_radps = y.drum_speed_radps + k.drum_speed_radps * c;
-        self.drum_integral_rad = y.drum_integral_rad + k.drum_integral_rad * c;
-        let n = y.pos.len();
-        self.pos.resize(n, Vec3::zeros());
-        self.vel.resize(n, Vec3::zeros());
-        for i in 0..n {
-            self.pos[i] = y.pos[i] + k.pos[i] * c;
-            self.vel[i] = y.vel[i] + k.vel[i] * c;
-        }
-    }
-
-    fn is_finite(&self) -> bool {
-        let v = |x: &Vec3| x.iter().all(|c| c.is_finite());
-        v(&self.r_ref)
-            && v(&self.v_ref)
-            && self.paid_out_m.is_finite()
-            && self.drum_speed_radps.is_finite()
-            && self.drum_integral_rad.is_finite()
-            && self.pos.iter().all(v)
-            && self.vel.iter().all(v)
-    }
-}
-
-/// What drives the tether at the reel during one derivative evaluation.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum ReelDrive {
-    /// l̇ imposed (ideal, lag, locked).
-    Rate(f64),
-    /// The drum's motor with this speed command (or tension command: [`motor_torque`]),
-    /// motion and brake.
-    Drum {
-        drum: DrumParams,
-        command_radps: f64,
-        tension_n: Option<f64>,
-        motion: Motion,
-        brake: bool,
-    },
-    /// The drum under a motor torque held over the inner tick (the flight drive).
-    Held {
-        drum: DrumParams,
-        torque_nm: f64,
-        motion: Motion,
-        brake: bool,
-    },
-}
-
-impl ReelDrive {
-    /// The reel's rate l̇ with the drum turning at `drum_speed_radps`, m/s.
-    fn rate_mps(&self, drum_speed_radps: f64) -> f64 {
-        match *self {
-            ReelDrive::Rate(v) => v,
-            ReelDrive::Drum {
-                motion: Motion::Stuck,
-                ..
-            }
-            | ReelDrive::Held {
-                motion: Motion::Stuck,
-                ..
-            } => 0.0,
-            ReelDrive::Drum { drum, .. } | ReelDrive::Held { drum, .. } => {
-                drum.radius_m * drum_speed_radps
-            }
-        }
-    }
-}
-
-/// The drum motor's torque and its speed loop's integrator rate: the speed loop's
-/// ([`DrumParams::speed_loop`]) under a rate command; under a tension command T (a tension law,
-/// `crate::laws`) the motor holds the tether back with −T·r (T ≥ 0: a tether only pulls) and
-/// compensates its drum's friction from the drum's model: while the drum turns, the viscous and
-/// Coulomb friction fed forward from its speed (so J ω̇ = r(T_reel − T) while it turns); while
-/// it is stuck, the breakaway torque in the direction the tether's pull `reel_tension_n` − T
-/// would turn it (the tension at the reel is measured: the load cell of the controller's
-/// input). Clamped to the torque limit; the speed loop's integrator rests.
-fn motor_torque(
-    d: &DrumParams,
-    tension_n: Option<f64>,
-    reel_tension_n: f64,
-    command_radps: f64,
-    speed_radps: f64,
-    integral_rad: f64,
-) -> (f64, f64) {
-    match tension_n {
-        Some(t) => {
-            let t = t.max(0.0);
-            let friction = if speed_radps != 0.0 {
-                d.viscous_nms * speed_radps + d.coulomb_nm * speed_radps.signum()
-            } else {
-                let pull = reel_tension_n - t;
-                if pull != 0.0 {
-                    d.static_nm * pull.signum()
-                } else {
-                    0.0
-                }
-            };
-            let torque = -d.radius_m * t + friction;
-            (torque.clamp(-d.max_torque_nm, d.max_torque_nm), 0.0)
-        }
-        None => d.speed_loop(command_radps, speed_radps, integral_rad),
-    }
-}
-
-/// The angles of a direction in the centre of mass's orbit frame (docs/equations.md §0):
-/// e_t = cosβ(cosα e_r + sinα e_θ) + sinβ e_h, and their rates in that frame.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Angles {
-    /// α, rad.
-    pub alpha_rad: f64,
-    /// α̇, rad/s.
-    pub alpha_rate_radps: f64,
-    /// β, rad.
-    pub beta_rad: f64,
-    /// β̇, rad/s.
-    pub beta_rate_radps: f64,
-}
+use tether::Layout;
 
 /// Everything observable about the truth model at one instant.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -554,14 +106,6 @@ pub struct FeedCounts {
     pub inserted: u64,
     /// Beads removed at the reel.
     pub removed: u64,
-}
-
-/// Preallocated buffers of one RK4 step.
-#[derive(Clone, Debug, Default)]
-struct Workspace {
-    k: [State; 4],
-    stage: State,
-    masses: Vec<f64>,
 }
 
 /// The reel's state between periods, by model.
@@ -985,7 +529,7 @@ impl ElasticPlant {
         }
         if let Some(d) = drum {
             fastest = fastest
-                .max(2.0 * d.speed_bandwidth_radps)
+                .max(d.speed_bandwidth_radps)
                 .max(d.viscous_nms / d.inertia_kgm2);
         }
         self.ws.masses = m;
@@ -1180,71 +724,12 @@ impl ElasticPlant {
             self.set_motion(motion);
         }
         let speed_start = self.y.drum_speed_radps;
-        let mut ws = std::mem::take(&mut self.ws);
         let drives = [
             self.drive(command, t0, brake),
             self.drive(command, t0 + 0.5 * h, brake),
             self.drive(command, t0 + h, brake),
         ];
-        let [k1, k2, k3, k4] = &mut ws.k;
-        derivative(
-            &self.p,
-            &self.layout,
-            &self.y,
-            drives[0],
-            &mut ws.masses,
-            k1,
-        );
-        ws.stage.set_stage(&self.y, 0.5 * h, k1);
-        derivative(
-            &self.p,
-            &self.layout,
-            &ws.stage,
-            drives[1],
-            &mut ws.masses,
-            k2,
-        );
-        ws.stage.set_stage(&self.y, 0.5 * h, k2);
-        derivative(
-            &self.p,
-            &self.layout,
-            &ws.stage,
-            drives[1],
-            &mut ws.masses,
-            k3,
-        );
-        ws.stage.set_stage(&self.y, h, k3);
-        derivative(
-            &self.p,
-            &self.layout,
-            &ws.stage,
-            drives[2],
-            &mut ws.masses,
-            k4,
-        );
-        let c = h / 6.0;
-        let y = &mut self.y;
-        let comb = |a: f64, b: f64, d: f64, e: f64| (a + 2.0 * b + 2.0 * d + e) * c;
-        y.r_ref += (k1.r_ref + k2.r_ref * 2.0 + k3.r_ref * 2.0 + k4.r_ref) * c;
-        y.v_ref += (k1.v_ref + k2.v_ref * 2.0 + k3.v_ref * 2.0 + k4.v_ref) * c;
-        y.paid_out_m += comb(k1.paid_out_m, k2.paid_out_m, k3.paid_out_m, k4.paid_out_m);
-        y.drum_speed_radps += comb(
-            k1.drum_speed_radps,
-            k2.drum_speed_radps,
-            k3.drum_speed_radps,
-            k4.drum_speed_radps,
-        );
-        y.drum_integral_rad += comb(
-            k1.drum_integral_rad,
-            k2.drum_integral_rad,
-            k3.drum_integral_rad,
-            k4.drum_integral_rad,
-        );
-        for i in 0..y.pos.len() {
-            y.pos[i] += (k1.pos[i] + k2.pos[i] * 2.0 + k3.pos[i] * 2.0 + k4.pos[i]) * c;
-            y.vel[i] += (k1.vel[i] + k2.vel[i] * 2.0 + k3.vel[i] * 2.0 + k4.vel[i]) * c;
-        }
-        self.ws = ws;
+        integration::rk4_step(&self.p, &self.layout, &mut self.y, drives, h, &mut self.ws);
         if let Some(d) = motor {
             let drive = self.drum_drive_nm(&d, command);
             let (motion, speed) = d.after_step(
@@ -1303,7 +788,7 @@ impl ElasticPlant {
         let mut m = std::mem::take(&mut self.ws.masses);
         loop {
             self.node_masses(&mut m);
-            match tether::feed(
+            match feed(
                 &self.p.tether,
                 &mut self.layout,
                 self.y.paid_out_m,
@@ -1318,181 +803,6 @@ impl ElasticPlant {
             }
         }
         self.ws.masses = m;
-    }
-}
-
-/// The time derivative of `y` (see the module doc) into `dy`.
-fn derivative(
-    p: &ElasticParams,
-    layout: &Layout,
-    y: &State,
-    drive: ReelDrive,
-    masses: &mut Vec<f64>,
-    dy: &mut State,
-) {
-    let t = &p.tether;
-    let b = &p.bodies;
-    let env = &p.environment;
-    layout.masses(t, b.main_initial_kg, b.sub_kg, y.paid_out_m, masses);
-    let n = masses.len();
-    dy.pos.resize(n, Vec3::zeros());
-    dy.vel.resize(n, Vec3::zeros());
-    let reel_rate = drive.rate_mps(y.drum_speed_radps);
-    dy.r_ref = y.v_ref;
-    let g_ref = env.gravity(&y.r_ref);
-    dy.v_ref = g_ref;
-    dy.paid_out_m = reel_rate;
-    // Forces: gravity relative to the reference particle's (exact), then the tether, drag and
-    // the momentum flux of the paid-out tether; divided by the masses at the end.
-    for (i, m) in masses.iter().enumerate() {
-        dy.pos[i] = y.vel[i];
-        dy.vel[i] = env.gravity_relative(&y.r_ref, &g_ref, &y.pos[i]) * *m;
-    }
-    let mut tension_reel = 0.0;
-    let cd_d = t.drag_coefficient * t.diameter_m;
-    for s in 0..n - 1 {
-        let d = y.pos[s + 1] - y.pos[s];
-        let chord = d.norm();
-        if chord == 0.0 {
-            continue;
-        }
-        let u = d / chord;
-        let chord_rate = (y.vel[s + 1] - y.vel[s]).dot(&u);
-        let (l, l_rate) = if s == 0 {
-            (layout.reel_segment_m(t, y.paid_out_m), reel_rate)
-        } else {
-            (t.segment_length_m, 0.0)
-        };
-        let tension = t.tension_n(chord, chord_rate, l, l_rate);
-        if s == 0 {
-            tension_reel = tension;
-        }
-        let f = u * tension;
-        dy.vel[s] += f;
-        dy.vel[s + 1] -= f;
-        if env.drag && cd_d > 0.0 {
-            let mid = y.r_ref + (y.pos[s] + y.pos[s + 1]) * 0.5;
-            let rho_air = env.air_density_kgpm3(&mid);
-            let v_air = y.v_ref + (y.vel[s] + y.vel[s + 1]) * 0.5 - air_velocity_mps(&mid);
-            let f = cylinder_drag_n(rho_air, cd_d * chord, &u, &v_air) * 0.5;
-            dy.vel[s] += f;
-            dy.vel[s + 1] += f;
-        }
-    }
-    if env.drag {
-        for (i, cda) in [(0, b.main_drag_area_m2), (n - 1, b.sub_drag_area_m2)] {
-            let r = y.r_ref + y.pos[i];
-            let v_air = y.v_ref + y.vel[i] - air_velocity_mps(&r);
-            dy.vel[i] += body_drag_n(env.air_density_kgpm3(&r), cda, &v_air);
-        }
-    }
-    // Paying out, ½ρl̇ kg/s of tether joins node 1 at node 0's velocity (winding in, it leaves
-    // node 1 for node 0 at node 1's velocity): the receiver's momentum changes by
-    // q·(v_donor − v_receiver), the donor's velocity not at all.
-    let q = 0.5 * t.density_kg_per_m * reel_rate;
-    if q > 0.0 {
-        dy.vel[1] += (y.vel[0] - y.vel[1]) * q;
-    } else if q < 0.0 {
-        dy.vel[0] += (y.vel[1] - y.vel[0]) * (-q);
-    }
-    for (v, m) in dy.vel.iter_mut().zip(masses.iter()) {
-        *v /= *m;
-    }
-    (dy.drum_speed_radps, dy.drum_integral_rad) = match drive {
-        ReelDrive::Rate(_) => (0.0, 0.0),
-        ReelDrive::Drum {
-            drum: d,
-            command_radps,
-            tension_n,
-            motion,
-            brake,
-        } => {
-            let (torque, integral_rate) = motor_torque(
-                &d,
-                tension_n,
-                tension_reel,
-                command_radps,
-                y.drum_speed_radps,
-                y.drum_integral_rad,
-            );
-            let drive = torque + d.radius_m * tension_reel;
-            let accel = d.accel_radps2(motion, drive, y.drum_speed_radps, brake);
-            (accel, integral_rate)
-        }
-        ReelDrive::Held {
-            drum: d,
-            torque_nm,
-            motion,
-            brake,
-        } => {
-            let drive = torque_nm + d.radius_m * tension_reel;
-            (
-                d.accel_radps2(motion, drive, y.drum_speed_radps, brake),
-                0.0,
-            )
-        }
-    };
-}
-
-/// The in-plane basis of an orbit of inclination `i` with the node and perigee on x:
-/// p̂ = x̂, q̂ = (0, cos i, sin i).
-fn plane_basis(inclination_rad: f64) -> (Vec3, Vec3) {
-    let (si, ci) = inclination_rad.sin_cos();
-    (Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, ci, si))
-}
-
-/// Position and velocity on the orbit at its initial true anomaly: Keplerian, except that a
-/// circular orbit (e = 0) with J2 on starts at the circular speed of the oblate field, so that
-/// it stays circular as the scenario says. At the Keplerian speed √(μ/a) the J2 field's extra
-/// pull, (3/2) J2 (R_e/a)² of the point mass's on the equator, would make it an orbit of
-/// e ≈ 1.3e-3 at 700 km (a ±9 km radius swing once an orbit), which forces a libration of the
-/// same order (docs/equations.md §16) that a controller told e = 0 cannot know: the 30 km keep
-/// moved by ±20 m. The speed balances the orbit-averaged radial gravity,
-/// v² = (μ/a) (1 + (3/2) J2 (R_e/a)² (1 − (3/2) sin² i)): exact on the equator (the radial
-/// J2 pull is then constant round the circle), first order in J2 on an inclined orbit, whose
-/// radial pull varies with latitude.
-fn orbit_state(o: &OrbitParams, env: &Environment) -> (Vec3, Vec3) {
-    let (p_hat, q_hat) = plane_basis(o.inclination_rad);
-    let a = o.orbit.semi_major_axis_m;
-    let e = o.orbit.eccentricity;
-    let semi_latus = a * (1.0 - e * e);
-    let (s, c) = o.initial_true_anomaly_rad.sin_cos();
-    let r = semi_latus / (1.0 + e * c);
-    let oblate = if env.j2 && e == 0.0 {
-        let re_a = environment::EARTH_EQUATORIAL_RADIUS_M / a;
-        let si = o.inclination_rad.sin();
-        1.0 + 1.5 * environment::EARTH_J2 * re_a * re_a * (1.0 - 1.5 * si * si)
-    } else {
-        1.0
-    };
-    let v = (o.orbit.mu_m3ps2 / semi_latus * oblate).sqrt();
-    (
-        (p_hat * c + q_hat * s) * r,
-        (p_hat * (-s) + q_hat * (e + c)) * v,
-    )
-}
-
-/// The orbit frame (e_r, e_θ, e_h) of a body at `r` moving at `v` (docs/equations.md §0).
-fn orbit_frame(r: &Vec3, v: &Vec3) -> (Vec3, Vec3, Vec3) {
-    let e_r = r.normalize();
-    let e_h = r.cross(v).normalize();
-    (e_r, e_h.cross(&e_r), e_h)
-}
-
-/// α, β of the direction `d` and their rates from `d_rate` (its derivative in the rotating
-/// orbit frame), with e_t = d/|d| = cosβ(cosα e_r + sinα e_θ) + sinβ e_h.
-fn direction_angles(d: &Vec3, d_rate: &Vec3, e_r: &Vec3, e_th: &Vec3, e_h: &Vec3) -> Angles {
-    let (x, y, z) = (d.dot(e_r), d.dot(e_th), d.dot(e_h));
-    let (xd, yd, zd) = (d_rate.dot(e_r), d_rate.dot(e_th), d_rate.dot(e_h));
-    let rho2 = x * x + y * y;
-    let norm = d.norm();
-    let s = z / norm;
-    let s_rate = (zd - s * (d.dot(d_rate) / norm)) / norm;
-    Angles {
-        alpha_rad: y.atan2(x),
-        alpha_rate_radps: (x * yd - y * xd) / rho2,
-        beta_rad: s.asin(),
-        beta_rate_radps: s_rate / (1.0 - s * s).sqrt(),
     }
 }
 
