@@ -324,7 +324,7 @@ pub fn output_names() -> Vec<String> {
     names
 }
 
-/// The laws named on the command line, in order, without repeats.
+/// The laws named on the command line, in order; a law named twice is refused.
 pub fn parse_laws(names: &[String]) -> Result<Vec<LawName>, UsageError> {
     let mut laws = Vec::new();
     for n in names {
@@ -334,9 +334,13 @@ pub fn parse_laws(names: &[String]) -> Result<Vec<LawName>, UsageError> {
                 LawName::ALL.map(LawName::as_str).join(", ")
             ))
         })?;
-        if !laws.contains(&law) {
-            laws.push(law);
+        if laws.contains(&law) {
+            return Err(UsageError(format!(
+                "--laws: {:?} is named twice (each law is flown once)",
+                law.as_str()
+            )));
         }
+        laws.push(law);
     }
     if laws.is_empty() {
         return Err(UsageError("--laws: name at least one law".into()));

@@ -36,6 +36,8 @@ pub const ROWS_CSV: &str = "eccentric.csv";
 pub const FIGURE_STEM: &str = "eccentric_keep_error";
 /// Pixel size of the figure.
 pub const FIGURE_SIZE_PX: (u32, u32) = (1000, 640);
+/// When the paper's stage 2 starts, s (8 h: Table 1's last stage-1 instant, `table1.rs`).
+pub const PAPER_STAGE2_START_S: f64 = 28_800.0;
 /// Most eccentricities one sweep flies.
 pub const MAX_ECCENTRICITIES: usize = 1000;
 
@@ -50,7 +52,7 @@ pub struct EccentricArgs {
     /// Override one scenario field, as for `tss-sim run` (applied before the eccentricity).
     #[arg(long = "set", short = 's', value_name = "KEY=VALUE")]
     pub set: Vec<String>,
-    /// Output directory [default: out/NAME-eccentric].
+    /// Output directory [default: out/NAME/eccentric].
     #[arg(long, short, value_name = "DIR")]
     pub out: Option<PathBuf>,
 }
@@ -68,7 +70,8 @@ pub struct KeepRow {
     pub keep2_error_m: f64,
     /// The summary's Table-1 figure of stage 1, max |simulated − paper|, m (NaN: not covered).
     pub table1_stage1_m: f64,
-    /// The same for stage 2, m.
+    /// The same for stage 2, m (NaN also when stage 2 does not start at the paper's 8 h,
+    /// [`PAPER_STAGE2_START_S`]: Table 1's stage-2 instants then fall elsewhere in the mission).
     pub table1_stage2_m: f64,
     /// The length at the end of the run, m.
     pub final_length_m: f64,
@@ -106,6 +109,9 @@ pub fn keep_row(scenario: &Scenario, history: &History) -> KeepRow {
             .max_abs_difference(stage)
             .map_or(f64::NAN, |d| d.difference_m.abs())
     };
+    // Table 1's stage-2 instants (14–15 h) follow the paper's stage-2 start: against a run
+    // whose stage 2 starts elsewhere they compare two different moments of the mission.
+    let stage2_as_paper = (stage2_s - PAPER_STAGE2_START_S).abs() < 0.5;
     let after_start = history.samples.iter().skip(1);
     let slack: Vec<f64> = after_start
         .clone()
@@ -122,7 +128,7 @@ pub fn keep_row(scenario: &Scenario, history: &History) -> KeepRow {
         ),
         keep2_error_m: worst(end_s - KEEP_WINDOW_S, end_s, scenario.stage2.keep_length_m),
         table1_stage1_m: table1(1),
-        table1_stage2_m: table1(2),
+        table1_stage2_m: if stage2_as_paper { table1(2) } else { f64::NAN },
         final_length_m: history.samples.last().map_or(f64::NAN, |s| s.length_m),
         completed: history
             .samples
@@ -151,28 +157,53 @@ pub fn sweep(path: &Path, sets: &[String], eccentricities: &[f64]) -> anyhow::Re
         .collect()
 }
 
-/// The table of `rows` as text.
+/// The table of `rows` as text. A Table-1 column no row has a figure for (the run does not
+/// cover its instants, or stage 2 starts elsewhere than the paper's) is left out.
 pub fn render(rows: &[KeepRow]) -> String {
+    let stage1 = rows.iter().any(|r| !r.table1_stage1_m.is_nan());
+    let stage2 = rows.iter().any(|r| !r.table1_stage2_m.is_nan());
     let mut o = String::new();
-    let _ = writeln!(
-        o,
-        "     e      a (km)  keep 1 (m)  keep 2 (m)  Table 1: stage 1  stage 2 (m)  final l (m)  done  min T (N)  slack (last, h)"
-    );
+    let _ = write!(o, "     e      a (km)  keep 1 (m)  keep 2 (m)");
+    match (stage1, stage2) {
+        (true, true) => o.push_str("  Table 1: stage 1  stage 2 (m)"),
+        (true, false) => o.push_str("  Table 1 stage 1 (m)"),
+        (false, true) => o.push_str("  Table 1 stage 2 (m)"),
+        (false, false) => {}
+    }
+    let _ = writeln!(o, "  final l (m)  done  min T (N)  slack (last, h)");
     for r in rows {
         let slack = if r.slack_samples == 0 {
             "0".to_string()
         } else {
             format!("{} ({:.2})", r.slack_samples, r.last_slack_s / 3600.0)
         };
-        let _ = writeln!(
+        let _ = write!(
             o,
-            "{:>6.3} {:>11.1} {:>11.3} {:>11.3} {:>17.3} {:>12.3} {:>12.3} {:>5} {:>10.2e}  {slack}",
+            "{:>6.3} {:>11.1} {:>11.3} {:>11.3}",
             r.eccentricity,
             r.semi_major_axis_m / 1000.0,
             r.keep1_error_m,
             r.keep2_error_m,
-            r.table1_stage1_m,
-            r.table1_stage2_m,
+        );
+        match (stage1, stage2) {
+            (true, true) => {
+                let _ = write!(
+                    o,
+                    " {:>17.3} {:>12.3}",
+                    r.table1_stage1_m, r.table1_stage2_m
+                );
+            }
+            (true, false) => {
+                let _ = write!(o, " {:>20.3}", r.table1_stage1_m);
+            }
+            (false, true) => {
+                let _ = write!(o, " {:>20.3}", r.table1_stage2_m);
+            }
+            (false, false) => {}
+        }
+        let _ = writeln!(
+            o,
+            " {:>12.3} {:>5} {:>10.2e}  {slack}",
             r.final_length_m,
             if r.completed { "yes" } else { "no" },
             r.min_tension_n,
@@ -207,7 +238,7 @@ pub fn run_eccentric(args: &EccentricArgs) -> anyhow::Result<()> {
     let dir = args
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from("out").join(format!("{name}-eccentric")));
+        .unwrap_or_else(|| crate::output::default_dir(&name, &args.set).join("eccentric"));
     let mut owned = vec![TABLE_TXT.to_string(), ROWS_CSV.to_string()];
     owned.extend(png_and_svg(FIGURE_STEM));
     let mut out = OutputSet::prepare("--out", &dir, owned)?;

@@ -86,6 +86,20 @@ pub struct History {
     /// The tether's shape every `plant.shape_interval_s` and at the end (elastic plant):
     /// (t_s, node positions relative to the main satellite in the orbit frame e_r, e_θ, e_h, m).
     pub shapes: Vec<(f64, Vec<[f64; 3]>)>,
+    /// The tether ran off the end of its spool, and the run stopped there (`None`: it did not).
+    pub spool_overrun: Option<SpoolOverrun>,
+}
+
+/// The tether paid out beyond the spool it is wound on (`envelope.max_length_m`): a reel has
+/// no more to give, so the run stops at that tick.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpoolOverrun {
+    /// When, s.
+    pub t_s: f64,
+    /// The paid-out length, m.
+    pub length_m: f64,
+    /// The spool's length, m.
+    pub spool_m: f64,
 }
 
 /// The controller's flag bits (`tss_reel::controller::Flags`, the `flags` column of

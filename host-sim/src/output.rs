@@ -25,6 +25,40 @@ use anyhow::Context as _;
 use crate::history::{PhaseLabel, Sample};
 use crate::usage::UsageError;
 
+/// The longest directory name [`default_dir`] makes from the overrides, bytes (file systems
+/// allow 255).
+const MAX_DEFAULT_DIR_NAME: usize = 120;
+
+/// Where a command writes without `--out`: `out/<scenario name>` for the file as it is, and
+/// `out/<name>+<key>=<value>+…` with `--set` overrides (their characters outside
+/// `[A-Za-z0-9._=+-]` written `_`; a name longer than 120 bytes ends in a hash of the
+/// overrides instead), so that a run with overrides never replaces the results of one without.
+pub fn default_dir(scenario_name: &str, sets: &[String]) -> PathBuf {
+    let mut name = scenario_name.to_string();
+    for set in sets {
+        name.push('+');
+        name.extend(set.chars().map(|c| {
+            if c.is_ascii_alphanumeric() || "._=+-".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        }));
+    }
+    if name.len() > MAX_DEFAULT_DIR_NAME {
+        let hash = fnv1a(sets.join("\n").as_bytes());
+        name = format!("{scenario_name}+{hash:016x}");
+    }
+    Path::new("out").join(name)
+}
+
+/// FNV-1a, 64 bits (Fowler, Noll and Vo): a short, stable name for a list of overrides.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
 /// Checks, without creating anything, that `dir` is a directory or can be created as one
 /// (`flag` names the option in the message).
 pub fn check_output_dir(flag: &str, dir: &Path) -> Result<(), UsageError> {

@@ -144,6 +144,19 @@ pub fn figure_names() -> Vec<String> {
         .collect()
 }
 
+/// What [`write_figures`] draws for this run, in words: Figs. 4–6, and the flight drive's
+/// figure and the tether's shape when the run has them.
+pub fn figures_heading(scenario: &Scenario, history: &History) -> String {
+    let mut parts = vec!["Figs. 4–6 of the paper".to_string()];
+    if drive_panels(scenario, history).is_some() {
+        parts.push("the flight drive's rate and duty".to_string());
+    }
+    if !history.shapes.is_empty() {
+        parts.push("the tether's shape on the elastic plant".to_string());
+    }
+    parts.join("; ")
+}
+
 /// A figure of panels stacked vertically.
 struct Panels(Vec<Panel>);
 
@@ -304,10 +317,13 @@ impl Figure for TetherShapes {
             .y_label_area_size(80)
             .build_cartesian_2d(xc - half..xc + half, yc - half..yc + half)
             .map_err(draw_error)?;
+        let span = 2.0 * half;
         chart
             .configure_mesh()
             .x_desc("along-track e_θ (km)")
             .y_desc("radial e_r (km)")
+            .x_label_formatter(&|x| tick_label(*x, span))
+            .y_label_formatter(&|y| tick_label(*y, span))
             .label_style((FONT, 16))
             .axis_desc_style((FONT, 18))
             .light_line_style(RGBColor(0xee, 0xee, 0xee))
@@ -485,6 +501,17 @@ fn padded_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// A tick's label on an axis spanning `span`: 0 for a tick within 10⁻⁹ of the span of zero
+/// (the axis' round numbers carry the float error of their sum: −1.7e-21 is 0), else the
+/// value to 6 significant digits, written as short as it reads back.
+pub fn tick_label(value: f64, span: f64) -> String {
+    if value.abs() <= 1e-9 * span.abs() {
+        return "0".to_string();
+    }
+    let rounded: f64 = format!("{value:.5e}").parse().unwrap_or(value);
+    format!("{rounded}")
+}
+
 /// Draws the panels stacked vertically on `root`.
 fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, panels: &[Panel]) -> anyhow::Result<()> {
     root.fill(&WHITE).map_err(draw_error)?;
@@ -508,10 +535,13 @@ fn draw_panel<DB: DrawingBackend>(
         .x_label_area_size(48)
         .y_label_area_size(80)
         .build_cartesian_2d(x0..x1, y0..y1)?;
+    let (x_span, y_span) = (x1 - x0, y1 - y0);
     chart
         .configure_mesh()
         .x_desc(panel.x_desc)
         .y_desc(panel.y_desc)
+        .x_label_formatter(&|x| tick_label(*x, x_span))
+        .y_label_formatter(&|y| tick_label(*y, y_span))
         .label_style((FONT, 16))
         .axis_desc_style((FONT, 18))
         .light_line_style(RGBColor(0xee, 0xee, 0xee))
@@ -527,6 +557,7 @@ fn draw_panel<DB: DrawingBackend>(
             .label("stage 2 starts")
             .legend(|(x, y)| PathElement::new([(x, y), (x + 24, y)], STAGE_LINE_COLOR));
     }
+    let width_px = area.dim_in_pixel().0 as usize;
     for curve in &panel.curves {
         let color = curve.color;
         let finite = curve
@@ -534,10 +565,19 @@ fn draw_panel<DB: DrawingBackend>(
             .iter()
             .copied()
             .filter(|p| p.0.is_finite() && p.1.is_finite());
+        // More points than pixels across: the segments are shorter than a pixel, and plotters'
+        // bitmap rasterizer fills such 2 px segments as polygons that spike out of the panel
+        // (the elastic Fig. 4(b)); one pixel is as wide as the curve can be drawn there anyway.
+        let stroke = if curve.points.len() > width_px { 1 } else { 2 };
         let drawn = if curve.dashed {
-            chart.draw_series(DashedLineSeries::new(finite, 8, 6, color.stroke_width(2)))?
+            chart.draw_series(DashedLineSeries::new(
+                finite,
+                8,
+                6,
+                color.stroke_width(stroke),
+            ))?
         } else {
-            chart.draw_series(LineSeries::new(finite, color.stroke_width(2)))?
+            chart.draw_series(LineSeries::new(finite, color.stroke_width(stroke)))?
         };
         drawn
             .label(curve.label)
@@ -568,6 +608,54 @@ mod tests {
         assert!(thin.contains(&(12_345.0, -3.0)));
         assert_eq!(thin.last(), pts.last());
         assert!(thin.windows(2).all(|w| w[0].0 < w[1].0));
+    }
+
+    /// A tick at the float error of zero read "-1.69407e-21" on an axis from −0.1 to 0.1.
+    #[test]
+    fn tick_labels_are_round_and_zero_is_zero() {
+        assert_eq!(tick_label(-1.694_07e-21, 0.2), "0");
+        assert_eq!(tick_label(0.1 + 0.2, 1.0), "0.3");
+        assert_eq!(tick_label(40_000.0, 50_000.0), "40000");
+        assert_eq!(tick_label(2.5e-5, 1e-4), "0.000025");
+    }
+
+    /// Issue 30 §5: the elastic Fig. 4(b), a tension jumping between 0 and 20 N from sample to
+    /// sample, was drawn with spikes down to the bottom of the image, below the plot area.
+    #[test]
+    fn a_jumping_curve_stays_inside_its_panel() {
+        let (w, h) = (600u32, 300u32);
+        let mut buf = vec![0u8; (w * h * 3) as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+            root.fill(&WHITE).unwrap();
+            let points = (0..4000)
+                .map(|i| (f64::from(i) / 200.0, if i % 7 < 3 { 0.0 } else { 20.0 }))
+                .collect();
+            let panel = Panel {
+                caption: "tension".to_string(),
+                x_desc: "t (h)",
+                y_desc: "T (N)",
+                curves: vec![Curve {
+                    label: "T",
+                    color: TENSION_COLOR,
+                    dashed: false,
+                    points,
+                }],
+                marker_x: None,
+            };
+            draw_panel(&root, &panel).unwrap();
+            root.present().unwrap();
+        }
+        // The bottom rows hold the x axis' description (black) and nothing red.
+        let red = |x: u32, y: u32| {
+            let i = ((y * w + x) * 3) as usize;
+            buf[i] > 0xa0 && buf[i + 1] < 0x60 && buf[i + 2] < 0x60
+        };
+        let below: usize = (h - 20..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .filter(|&(x, y)| red(x, y))
+            .count();
+        assert_eq!(below, 0, "red pixels below the plot area");
     }
 
     #[test]

@@ -12,7 +12,7 @@
 //! [`ScenarioError`]: crate::scenario::ScenarioError
 
 use std::io::{IsTerminal, Write};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
@@ -27,6 +27,7 @@ use crate::scenario::Scenario;
 use crate::sim::SimError;
 use crate::table1::{probe_times_for, Table1Comparison};
 use crate::usage::{quiet, UsageError};
+use crate::verdict::Verdict;
 
 /// Arguments of `tss-sim run`.
 #[derive(clap::Args, Clone, Debug)]
@@ -63,6 +64,9 @@ pub struct PilArgs {
 /// The report of the PIL link.
 pub const PIL_TXT: &str = "pil.txt";
 
+/// The run's verdict, machine-readable (`crate::verdict::Verdict::to_json`).
+pub const VERDICT_JSON: &str = "verdict.json";
+
 /// Every file `tss-sim run` may write into its output directory.
 pub fn output_names() -> Vec<String> {
     let mut names: Vec<String> = [
@@ -71,6 +75,7 @@ pub fn output_names() -> Vec<String> {
         "summary.txt",
         "faults.txt",
         "scenario.toml",
+        VERDICT_JSON,
         PIL_TXT,
         FIRMWARE_LOG,
     ]
@@ -91,6 +96,8 @@ pub struct RunOutcome {
     pub figures: Vec<PathBuf>,
     /// Why the figures could not be drawn (the other outputs are written regardless).
     pub figure_error: Option<anyhow::Error>,
+    /// What the figures are, for the heading above their list.
+    pub figures_heading: String,
     /// Wall time of the simulation.
     pub sim_time: Duration,
     /// Wall time of writing every output.
@@ -184,27 +191,90 @@ pub fn print_outcome(o: &RunOutcome) {
         let _ = writeln!(stdout, "  {}", p.display());
     }
     if o.figure_error.is_none() {
-        let _ = writeln!(
-            stdout,
-            "Figures (Figs. 4–6 of the paper; the tether's shape on the elastic plant):"
-        );
+        let _ = writeln!(stdout, "Figures ({}):", o.figures_heading);
         for p in &o.figures {
             let _ = writeln!(stdout, "  {}", p.display());
         }
     }
 }
 
-/// The output directory: `--out`, else `out/<scenario name>`.
+/// The output directory: `--out`, else [`output::default_dir`] of the scenario and its
+/// overrides (`-pil` after it for a run with the firmware in the loop), so that a run never
+/// replaces another's results unasked.
 pub fn output_dir(args: &RunArgs, scenario: &Scenario) -> PathBuf {
-    args.out
-        .clone()
-        .unwrap_or_else(|| Path::new("out").join(&scenario.name))
+    if let Some(dir) = &args.out {
+        return dir.clone();
+    }
+    let dir = output::default_dir(&scenario.name, &args.set);
+    if args.pil.enabled {
+        let mut name = dir.into_os_string();
+        name.push("-pil");
+        PathBuf::from(name)
+    } else {
+        dir
+    }
+}
+
+/// Seconds per hour: a line of progress per simulated hour when stderr is not a terminal.
+const PROGRESS_LINE_S: f64 = 3600.0;
+
+/// How a run shows its progress: a bar on a terminal, a line per simulated hour elsewhere
+/// (a batch log is never silent), nothing under `--quiet`.
+enum Progress {
+    Bar(ProgressBar),
+    Lines {
+        duration_s: f64,
+        next_s: f64,
+        started: Instant,
+    },
+    Silent,
+}
+
+impl Progress {
+    fn new(duration_s: f64) -> Self {
+        if quiet() {
+            Self::Silent
+        } else if std::io::stderr().is_terminal() {
+            Self::Bar(progress_bar(duration_s))
+        } else {
+            Self::Lines {
+                duration_s,
+                next_s: PROGRESS_LINE_S,
+                started: Instant::now(),
+            }
+        }
+    }
+
+    fn at(&mut self, t_s: f64) {
+        match self {
+            Self::Bar(bar) => bar.set_position(t_s.max(0.0) as u64),
+            Self::Lines {
+                duration_s,
+                next_s,
+                started,
+            } => {
+                if t_s >= *next_s {
+                    eprintln!(
+                        "simulated {:.0} h of {:.1} h ({:.0} s of wall time)",
+                        (t_s / PROGRESS_LINE_S).floor(),
+                        *duration_s / PROGRESS_LINE_S,
+                        started.elapsed().as_secs_f64()
+                    );
+                    *next_s = (t_s / PROGRESS_LINE_S).floor() * PROGRESS_LINE_S + PROGRESS_LINE_S;
+                }
+            }
+            Self::Silent => {}
+        }
+    }
+
+    fn finish(self) {
+        if let Self::Bar(bar) = self {
+            bar.finish_and_clear();
+        }
+    }
 }
 
 fn progress_bar(duration_s: f64) -> ProgressBar {
-    if quiet() || !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
     // Whole seconds of mission time; the bar's unit.
     let bar = ProgressBar::new(duration_s.ceil().max(1.0) as u64);
     if let Ok(style) =
@@ -233,13 +303,11 @@ where
     let mut out = OutputSet::prepare("--out", &dir, output_names())?;
 
     let probes = probe_times_for(&scenario);
-    let bar = progress_bar(scenario.simulation.duration_s);
+    let mut progress = Progress::new(scenario.simulation.duration_s);
     let started = Instant::now();
-    let history = simulate(&scenario, &probes, &mut out, &mut |t_s| {
-        bar.set_position(t_s.max(0.0) as u64)
-    })
-    .with_context(|| format!("simulating {}", args.scenario.display()));
-    bar.finish_and_clear();
+    let history = simulate(&scenario, &probes, &mut out, &mut |t_s| progress.at(t_s))
+        .with_context(|| format!("simulating {}", args.scenario.display()));
+    progress.finish();
     let history = history?;
     let sim_time = started.elapsed();
 
@@ -269,8 +337,15 @@ where
         )?;
         w.write_all(resolved.as_bytes())
     })?);
+    let verdict = Verdict::of(&scenario, &history);
+    files.push(out.write(VERDICT_JSON, |w| w.write_all(verdict.to_json().as_bytes()))?);
     let summary = summarize(&scenario, &history);
-    let report = format!("{}\n{}", summary.render(), table.render());
+    let report = format!(
+        "{}\n{}\n{}",
+        verdict.headline(),
+        summary.render(),
+        table.render()
+    );
     files.push(out.write("summary.txt", |w| w.write_all(report.as_bytes()))?);
     // The fault summary (faults.rs): printed after the report and written to faults.txt.
     let faults = crate::faults::render_fault_summary(&scenario, &history.faults);
@@ -298,6 +373,7 @@ where
         files,
         figures,
         figure_error,
+        figures_heading: plots::figures_heading(&scenario, &history),
         sim_time,
         write_time,
         report,

@@ -18,7 +18,125 @@
 
 use std::collections::VecDeque;
 
-use crate::faults::{Channel, Pcg32, SensorErrors, Window};
+use serde::{Deserialize, Serialize};
+
+use crate::random::Pcg32;
+
+/// One sensor's errors, in the sensor's own unit (m, rad, rad/s), applied in the order bias,
+/// noise, quantisation, then a stuck window freezes the reading.
+/// The default is a perfect sensor.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SensorErrors {
+    /// Standard deviation of white Gaussian noise added every sample (0 = none).
+    pub noise_std: f64,
+    /// Constant offset added to every sample.
+    pub bias: f64,
+    /// Quantisation step: the reading is rounded to a multiple of it (0 = none).
+    pub quantum: f64,
+    /// While in this window the sensor repeats the reading it gave at its start (`None`:
+    /// never stuck).
+    pub stuck: Option<Window>,
+}
+
+impl SensorErrors {
+    /// `true` if the sensor reads the truth.
+    pub fn is_perfect(&self) -> bool {
+        self.noise_std == 0.0 && self.bias == 0.0 && self.quantum == 0.0 && self.stuck.is_none()
+    }
+}
+
+/// A quantity the controller reads: what a `[[faults.corrupt]]` entry's `sensor` names
+/// (written in scenario files as [`SensedQuantity::as_str`] gives it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SensedQuantity {
+    /// The tether length (encoder), m.
+    Length,
+    /// α, rad.
+    Alpha,
+    /// α̇, rad/s.
+    AlphaRate,
+    /// The orbit rate θ̇, rad/s.
+    OrbitRate,
+    /// The reel's rate from the encoder, m/s.
+    ReelRate,
+    /// The tension from the load cell, N.
+    Tension,
+}
+
+impl SensedQuantity {
+    /// The name as written in scenario files and messages.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Length => "length",
+            Self::Alpha => "alpha",
+            Self::AlphaRate => "alpha_rate",
+            Self::OrbitRate => "orbit_rate",
+            Self::ReelRate => "reel_rate",
+            Self::Tension => "tension",
+        }
+    }
+}
+
+/// A time window [from_s, until_s) on the control ticks, s (until inf = to the end of the run).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Window {
+    /// Start, s.
+    pub from_s: f64,
+    /// End (excluded), s.
+    pub until_s: f64,
+}
+
+impl Window {
+    /// `t_s` is inside the window.
+    pub fn contains(&self, t_s: f64) -> bool {
+        t_s >= self.from_s && t_s < self.until_s
+    }
+}
+
+/// One sensor: bias, noise, quantisation, stuck window.
+#[derive(Clone, Debug)]
+pub(crate) struct Channel {
+    cfg: SensorErrors,
+    rng: Pcg32,
+    held: Option<f64>,
+}
+
+impl Channel {
+    pub(crate) fn new(cfg: &SensorErrors, seed: u64, stream: u64) -> Self {
+        Self {
+            cfg: cfg.clone(),
+            rng: Pcg32::new(seed, stream),
+            held: None,
+        }
+    }
+
+    pub(crate) fn read(&mut self, truth: f64, t_s: f64) -> f64 {
+        let c = &self.cfg;
+        // Drawn every tick, used or not, so that the noise sequence is tied to time.
+        let noise = if c.noise_std > 0.0 {
+            c.noise_std * self.rng.normal()
+        } else {
+            0.0
+        };
+        let mut v = truth;
+        if c.bias != 0.0 {
+            v += c.bias;
+        }
+        if noise != 0.0 {
+            v += noise;
+        }
+        if c.quantum > 0.0 {
+            v = (v / c.quantum).round() * c.quantum;
+        }
+        if c.stuck.is_some_and(|w| w.contains(t_s)) {
+            *self.held.get_or_insert(v)
+        } else {
+            self.held = None;
+            v
+        }
+    }
+}
 
 /// The swing sensor's parameters (`[sensors.alpha]`, `[[faults.alpha_dropout]]`).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -267,6 +385,44 @@ impl LoadCell {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn channel(cfg: SensorErrors) -> Channel {
+        Channel::new(&cfg, 1, 1)
+    }
+
+    #[test]
+    fn bias_quantum_and_stuck_window() {
+        let mut c = channel(SensorErrors {
+            bias: 0.3,
+            quantum: 0.25,
+            stuck: Some(Window {
+                from_s: 2.0,
+                until_s: 4.0,
+            }),
+            ..SensorErrors::default()
+        });
+        assert_eq!(c.read(1.0, 0.0), 1.25); // 1.3 → 1.25
+        assert_eq!(c.read(1.2, 1.0), 1.5);
+        assert_eq!(c.read(2.0, 2.0), 2.25); // stuck from here
+        assert_eq!(c.read(3.0, 3.0), 2.25);
+        assert_eq!(c.read(4.0, 4.0), 4.25); // released
+    }
+
+    #[test]
+    fn noise_has_the_stated_deviation() {
+        let mut c = channel(SensorErrors {
+            noise_std: 0.01,
+            ..SensorErrors::default()
+        });
+        let n = 20_000;
+        let rms = ((0..n)
+            .map(|i| c.read(5.0, f64::from(i)) - 5.0)
+            .map(|e| e * e)
+            .sum::<f64>()
+            / f64::from(n))
+        .sqrt();
+        assert!((rms - 0.01).abs() < 5e-4, "{rms}");
+    }
 
     fn swing(model: SwingSensorModel) -> SwingSensor {
         SwingSensor::new(&model, 7, 2, 4)

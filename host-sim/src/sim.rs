@@ -7,82 +7,28 @@
 //! (zero-order hold) while the plant steps. The plant is either of `[plant] model`'s, behind
 //! the [`Plant`] trait: the rigid rod of Eq. 5 (`plant::RigidPlant`, its reel ideal or
 //! lagging and saturating) or the elastic truth model (`elastic::ElasticPlant`). Every tick
-//! feeds the fault summary (`History::faults`).
+//! feeds the fault summary (`History::faults`). A tether paid out beyond its spool
+//! (`envelope.max_length_m`) ends the run at that tick (`History::spool_overrun`).
 
-use crate::elastic::{ElasticError, ElasticParams, ElasticPlant, InitialConditions};
+use crate::elastic::{ElasticParams, ElasticPlant, InitialConditions};
 use crate::faults::{InjectionPlan, Injector, Reading, Sensed, SummaryBuilder, TickRecord, Truth};
-use crate::history::{History, PhaseLabel, Sample};
+use crate::history::{History, PhaseLabel, Sample, SpoolOverrun};
+use crate::laws::LawStepper;
 use crate::plant::{ix, Command, Observation, Plant, RigidModel, RigidPlant, State};
 use crate::reel::{Reel, ReelDrive};
-use crate::scenario::{LawName, PlantModel, Scenario};
-use tss_reel::controller::{Config, ConfigError, Controller, Input, Output, Phase};
+use crate::scenario::{PlantModel, Scenario};
+use crate::stepper::ticks;
+pub use crate::stepper::{controller_config, SimError, Stepper};
+use tss_reel::controller::{Config, Controller, Input, Output, Phase};
 use tss_reel::orbit::Orbit;
 use tss_reel::schedule::BandSchedule;
 use tss_reel::Real;
-
-/// Why a run could not be completed.
-#[derive(Debug, thiserror::Error)]
-pub enum SimError {
-    /// The scenario's numbers do not make a valid controller.
-    #[error("controller configuration rejected: {0}")]
-    Config(ConfigError),
-    /// A timing field is not a whole number of control periods.
-    #[error("{field} = {value} s is not a whole number of control periods ({period_s} s)")]
-    Timing {
-        /// The scenario field.
-        field: &'static str,
-        /// Its value, s.
-        value: f64,
-        /// The control period, s.
-        period_s: f64,
-    },
-    /// The controller in the loop failed (the processor-in-the-loop link, `crate::pil`).
-    #[error("the processor-in-the-loop link failed")]
-    Link(#[source] Box<dyn std::error::Error + Send + Sync>),
-    /// The elastic plant's parameters are invalid.
-    #[error("{0}")]
-    Elastic(#[from] ElasticError),
-    /// The plant state stopped being finite (a physically impossible run).
-    #[error("the plant state became non-finite at t = {t_s} s")]
-    Diverged {
-        /// Mission time, s.
-        t_s: f64,
-    },
-}
-
-/// The controller configuration a scenario describes, in the controller's scalar type
-/// ([`Scenario::controller_config`]), once the stage-2 start is a whole number of periods.
-pub fn controller_config<T: Real>(sc: &Scenario) -> Result<Config<T>, SimError> {
-    ticks(
-        "stage2.start_time_s",
-        sc.stage2.start_time_s,
-        sc.controller.period_s,
-    )?;
-    Ok(sc.controller_config())
-}
 
 /// The rigid plant's equations a scenario describes.
 pub fn plant(sc: &Scenario) -> RigidModel {
     RigidModel {
         orbit: Orbit::elliptic(sc.orbit.semi_major_axis_m, sc.orbit.eccentricity),
         masses: sc.mass_model(),
-    }
-}
-
-/// `value_s` as a whole number of periods (to 1e-9 relative), or a [`SimError::Timing`].
-fn ticks(field: &'static str, value_s: f64, period_s: f64) -> Result<u32, SimError> {
-    let n = (value_s / period_s).round();
-    let ok = n >= 0.0
-        && n <= f64::from(u32::MAX)
-        && (n * period_s - value_s).abs() <= 1e-9 * value_s.abs().max(period_s);
-    if ok {
-        Ok(n as u32)
-    } else {
-        Err(SimError::Timing {
-            field,
-            value: value_s,
-            period_s,
-        })
     }
 }
 
@@ -119,9 +65,9 @@ pub fn run(
     probe_times_s: &[f64],
     progress: &mut dyn FnMut(f64),
 ) -> Result<History, SimError> {
-    match sc.controller.law {
-        LawName::Paper => run_with::<f32>(sc, probe_times_s, progress),
-        law => crate::laws::run(sc, law, probe_times_s, progress),
+    match LawStepper::new(sc, sc.controller.law)? {
+        Some(mut law) => run_stepper::<f32, _>(sc, &mut law, probe_times_s, progress),
+        None => run_with::<f32>(sc, probe_times_s, progress),
     }
 }
 
@@ -134,36 +80,6 @@ pub fn run_with<T: Real>(
 ) -> Result<History, SimError> {
     let mut ctl = Controller::new(controller_config::<T>(sc)?).map_err(SimError::Config)?;
     run_stepper(sc, &mut ctl, probe_times_s, progress)
-}
-
-/// The controller in the loop, one control period at a time: the core linked into the
-/// simulator ([`Controller`]) or the flight firmware in QEMU over the processor-in-the-loop
-/// link (`crate::pil`).
-pub trait Stepper<T> {
-    /// One control period: `input` is the sensed sample, `None` when none arrived (a dropout).
-    fn step(&mut self, tick: u32, input: Option<&Input<T>>) -> Result<Output<T>, SimError>;
-
-    /// The reel command of the period `out` was decided for: the rate command and its
-    /// acceleration (the paper's law); a tension law (`crate::laws`) commands a tension.
-    fn reel_command(&self, out: &Output<T>) -> Command
-    where
-        T: Real,
-    {
-        Command {
-            rate_mps: out.rate_cmd_mps.to_f64(),
-            accel_mps2: out.accel_cmd_mps2.to_f64(),
-            tension_n: None,
-        }
-    }
-}
-
-impl<T: Real> Stepper<T> for Controller<T> {
-    fn step(&mut self, tick: u32, input: Option<&Input<T>>) -> Result<Output<T>, SimError> {
-        Ok(match input {
-            Some(x) => *Controller::step(self, x),
-            None => *self.step_missing(tick),
-        })
-    }
 }
 
 /// Runs the scenario with `stepper` as the controller: the plant loop of [`run_with`].
@@ -211,6 +127,7 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
         tension_n: None,
     };
     let mut last_length_m: Option<f64> = None;
+    let spool_m = sc.envelope.max_length_m;
     for tick in 0..=total {
         let t_s = f64::from(tick) * period;
         if !plant.is_finite() {
@@ -221,7 +138,7 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
         let truth = Truth {
             length_m: seen.length_m,
             reel_rate_mps: last_length_m
-                .map_or(sc.initial.length_rate_mps, |l| (seen.length_m - l) / period),
+                .map_or(release_rate_mps(sc), |l| (seen.length_m - l) / period),
             tension_n: now.tension_n,
             alpha_rad: seen.alpha_rad,
             alpha_rate_radps: seen.alpha_rate_radps,
@@ -242,6 +159,7 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
                 t_s,
                 length_m: obs.length_m,
                 tension_n: obs.tension_n,
+                alpha_rad: obs.alpha_rad,
                 missing: sensed == Sensed::Missing,
                 reel: obs.reel,
             },
@@ -253,13 +171,22 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
             }
             next_probe += 1;
         }
-        if tick % every == 0 || tick == total {
+        // The tether cannot pay out beyond its spool: the run stops at the tick it does.
+        if obs.length_m > spool_m {
+            history.spool_overrun = Some(SpoolOverrun {
+                t_s,
+                length_m: obs.length_m,
+                spool_m,
+            });
+        }
+        let last = tick == total || history.spool_overrun.is_some();
+        if tick % every == 0 || last {
             history.samples.push(sample(&obs, t_s, &out));
             if let Some(e) = obs.elastic {
                 history.elastic.push(e);
             }
         }
-        if shape_every.is_some_and(|n| tick % n == 0) || tick == total {
+        if shape_every.is_some_and(|n| tick % n == 0) || last {
             if let Some(nodes) = plant.shape() {
                 history.shapes.push((t_s, nodes));
             }
@@ -267,7 +194,7 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
         if tick % progress_every == 0 {
             progress(t_s);
         }
-        if tick == total {
+        if last {
             break;
         }
         plant.step(&command, period);
@@ -305,13 +232,23 @@ pub fn elastic_initial<T: Real>(sc: &Scenario, cfg: &Config<T>) -> InitialCondit
     }
 }
 
+/// The reel's rate at t = 0: the release rate l̇(0), or 0 when the reel is locked (a locked
+/// drum turns neither at once nor through its lag).
+fn release_rate_mps(sc: &Scenario) -> f64 {
+    if sc.reel.locked {
+        0.0
+    } else {
+        sc.initial.length_rate_mps
+    }
+}
+
 /// The plant `[plant] model` selects, at its initial state.
 pub fn flown_plant<T: Real>(sc: &Scenario, cfg: &Config<T>) -> Result<Box<dyn Plant>, SimError> {
     Ok(match sc.plant.model {
         PlantModel::Rigid => Box::new(RigidPlant {
             model: plant(sc),
             x: initial_state(sc, cfg),
-            reel: Reel::new(&ReelDrive::from(&sc.reel), sc.initial.length_rate_mps),
+            reel: Reel::new(&ReelDrive::from(&sc.reel), release_rate_mps(sc)),
             substeps: sc.simulation.substeps.max(1),
             locked: sc.reel.locked,
             period_s: sc.controller.period_s,

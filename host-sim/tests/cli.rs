@@ -129,3 +129,126 @@ fn values_the_simulation_refuses_before_its_first_step_are_usage_errors() {
     assert!(text(&o.stderr).contains("simulation.output_interval_s"));
     assert!(!out.exists());
 }
+
+/// Issue 28 §3: with stderr not a terminal (a batch job's log) a run printed nothing until it
+/// ended. It prints a line per simulated hour (and nothing under `--quiet`, above).
+#[test]
+fn a_run_logs_its_progress_every_simulated_hour_when_not_on_a_terminal() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("p");
+    let o = tss_sim(&[
+        "run",
+        paper().to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        "simulation.duration_s=10800",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    for h in 1..=3 {
+        assert!(err.contains(&format!("simulated {h} h of 3.0 h")), "{err}");
+    }
+}
+
+fn tss_sim_in(cwd: &Path, args: &[&str]) -> Output {
+    Command::new(BIN)
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("tss-sim runs")
+}
+
+/// Issue 30 §5: the README's eccentric example (`run scenarios/paper.toml --set
+/// orbit.eccentricity=0.1 …`, no `--out`) replaced the results of the plain `run
+/// scenarios/paper.toml` in out/paper. A run with overrides writes beside it, and a PIL run
+/// too.
+#[test]
+fn a_run_without_out_never_replaces_another_runs_results() {
+    let tmp = tempfile::tempdir().unwrap();
+    let paper = paper();
+    let plain = tss_sim_in(
+        tmp.path(),
+        &[
+            "-q",
+            "run",
+            paper.to_str().unwrap(),
+            "--set",
+            "simulation.duration_s=60",
+        ],
+    );
+    assert!(plain.status.success(), "{}", text(&plain.stderr));
+    let dirs = |p: &Path| -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(p)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    };
+    let first = dirs(&tmp.path().join("out"));
+    assert_eq!(first.len(), 1, "{first:?}");
+    let varied = tss_sim_in(
+        tmp.path(),
+        &[
+            "-q",
+            "run",
+            paper.to_str().unwrap(),
+            "--set",
+            "simulation.duration_s=60",
+            "--set",
+            "orbit.eccentricity=0.05",
+        ],
+    );
+    assert!(varied.status.success(), "{}", text(&varied.stderr));
+    let second = dirs(&tmp.path().join("out"));
+    assert_eq!(second.len(), 2, "{second:?}");
+    assert!(second.contains(&first[0]));
+    assert!(
+        second.iter().any(|d| d.contains("orbit.eccentricity=0.05")),
+        "{second:?}"
+    );
+}
+
+/// Issue 30 §5: a rigid run listed its figures under a heading about the tether's shape on the
+/// elastic plant.
+#[test]
+fn a_rigid_run_s_figures_are_not_said_to_show_the_tether_s_shape() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("r");
+    let o = tss_sim(&[
+        "run",
+        paper().to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        "simulation.duration_s=60",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let stdout = text(&o.stdout);
+    assert!(
+        stdout.contains("Figures (Figs. 4–6 of the paper):"),
+        "{stdout}"
+    );
+    assert!(!stdout.contains("shape"), "{stdout}");
+}
+
+/// Issue 28 §3: `compare --laws paper,paper` flew the law once and said nothing.
+#[test]
+fn compare_refuses_a_law_named_twice() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = tss_sim(&[
+        "compare",
+        paper().to_str().unwrap(),
+        "--laws",
+        "paper,rupp,paper",
+        "-o",
+        tmp.path().join("c").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("named twice"),
+        "{}",
+        text(&o.stderr)
+    );
+}

@@ -171,3 +171,40 @@ fn eccentric_writes_its_table_csv_and_figure() {
         .unwrap();
     assert_eq!(bad.status.code(), Some(2));
 }
+
+/// Issue 30 §5: `eccentric scenarios/paper-eccentric.toml` wrote to
+/// out/paper-eccentric-eccentric, and its table showed a "Table 1 stage 2" column although
+/// the scenario's stage 2 starts at 16 h, not at the paper's 8 h: Table 1's stage-2 instants
+/// (14–15 h) then fall in the stage-1 keep. The sweep writes to out/paper-eccentric/eccentric
+/// and leaves the column out.
+#[test]
+fn eccentric_writes_beside_the_scenario_s_runs_without_a_meaningless_column() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = Command::new(BIN)
+        .args(["-q", "eccentric"])
+        .arg(scenario("paper-eccentric.toml"))
+        .args(["--eccentricity", "0"])
+        .args(["--set", "simulation.duration_s=28800"])
+        .current_dir(tmp.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let dir = tmp
+        .path()
+        .join("out/paper-eccentric+simulation.duration_s=28800/eccentric");
+    let table = std::fs::read_to_string(dir.join("eccentric.txt")).unwrap();
+    assert!(table.contains("Table 1 stage 1"), "{table}");
+    assert!(!table.contains("stage 2"), "{table}");
+    // With the paper's stage 2 (at 8 h) the column is there.
+    let r = fly(&paper(), &["simulation.duration_s=54000"]);
+    assert!(r.table1_stage2_m.is_finite(), "{r:?}");
+    let r = fly(
+        &paper(),
+        &["simulation.duration_s=54000", "stage2.start_time_s=30000"],
+    );
+    assert!(r.table1_stage2_m.is_nan(), "{r:?}");
+}

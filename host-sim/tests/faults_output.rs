@@ -46,3 +46,158 @@ fn run_prints_and_writes_the_fault_summary() {
     }
     assert!(stdout.contains(&text), "the summary is printed too");
 }
+
+fn scenario(file: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenarios")
+        .join(file)
+}
+
+/// Runs `tss-sim run` of `file` with `sets` into a temporary directory; returns its stdout,
+/// `verdict.json` and `faults.txt`.
+fn fly(file: &str, sets: &[&str]) -> (String, String, String) {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let mut cmd = Command::new(BIN);
+    cmd.arg("run").arg(scenario(file)).arg("--out").arg(&out);
+    for s in sets {
+        cmd.args(["--set", s]);
+    }
+    let o = cmd.output().unwrap();
+    assert!(
+        o.status.success(),
+        "{file} {sets:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let read = |f: &str| std::fs::read_to_string(out.join(f)).unwrap_or_default();
+    (
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        read("verdict.json"),
+        read("faults.txt"),
+    )
+}
+
+/// Issue 28 §3: a run in which the tether tumbled (|α| past π/2: on main's issue-28 case at
+/// 5 370 s, up to 4.07 rad) headlined "deploy reaches 30 km". Here a locked reel holds a tether
+/// spun at 0.01 rad/s, ten times the orbit rate: it tumbles, and the headline and the verdict
+/// say so first.
+#[test]
+fn a_tumbling_tether_is_headlined_as_a_failure() {
+    let (stdout, verdict, faults) = fly(
+        "paper.toml",
+        &[
+            "reel.locked=true",
+            "initial.delta_rate_radps=0.01",
+            "simulation.duration_s=3600",
+        ],
+    );
+    let first = stdout.lines().next().unwrap_or_default();
+    assert!(first.starts_with("verdict: FAILED: tumble"), "{stdout}");
+    assert!(verdict.contains("\"passed\": false"), "{verdict}");
+    assert!(verdict.contains("\"kind\": \"tumble\""), "{verdict}");
+    assert!(faults.contains("past π/2 (tumbled)"), "{faults}");
+}
+
+/// Issue 28 §3 (and §1's second case): α read as 0 from 1 h on; the tether went slack. The
+/// slack tether and the mission that went no further are the headline and the verdict.
+#[test]
+fn a_slack_tether_is_headlined_as_a_failure() {
+    let (stdout, verdict, _) = fly(
+        "paper-reel-limits.toml",
+        &[
+            "faults.corrupt=[{ sensor = \"alpha\", from_s = 3600.0, until_s = 1e9, value = 0.0 }]",
+            "simulation.duration_s=21600",
+        ],
+    );
+    let first = stdout.lines().next().unwrap_or_default();
+    assert!(first.starts_with("verdict: FAILED"), "{stdout}");
+    assert!(first.contains("slack tether"), "{first}");
+    assert!(verdict.contains("\"passed\": false"), "{verdict}");
+    assert!(verdict.contains("\"kind\": \"slack\""), "{verdict}");
+}
+
+/// Issue 28 §1's first case: the swing sensor stuck from 1 h, deployment stalled at 17.8 km
+/// with health nominal; the run's headline said nothing of it.
+#[test]
+fn a_stalled_mission_is_headlined_as_a_failure() {
+    let (stdout, verdict, _) = fly(
+        "paper-reel-limits.toml",
+        &[
+            "sensors.alpha_rate.enabled=false",
+            "sensors.alpha.noise_std=1e-4",
+            "sensors.seed=3",
+            "sensors.alpha.stuck_from_s=3600",
+            "sensors.alpha.stuck_until_s=1e9",
+            "simulation.duration_s=21600",
+        ],
+    );
+    let first = stdout.lines().next().unwrap_or_default();
+    assert!(first.starts_with("verdict: FAILED"), "{stdout}");
+    assert!(verdict.contains("\"passed\": false"), "{verdict}");
+    assert!(verdict.contains("\"kind\": \"stalled\""), "{verdict}");
+}
+
+/// A run that does what it should says so, and says what it checked.
+#[test]
+fn a_run_without_failures_passes() {
+    let (stdout, verdict, _) = fly("paper.toml", &["simulation.duration_s=3600"]);
+    assert!(stdout.starts_with("verdict: passed"), "{stdout}");
+    assert!(verdict.contains("\"passed\": true") && verdict.contains("\"failures\": []"));
+}
+
+/// Issue 28 §3: a sensed length stuck at 1 km deploys the tether for ever; on main it paid
+/// out past the spool's 40 km and on. The run stops at the spool's end and says so.
+#[test]
+fn a_tether_paid_out_past_its_spool_stops_the_run_and_fails_it() {
+    let (stdout, verdict, _) = fly(
+        "paper.toml",
+        &[
+            "faults.corrupt=[{ sensor = \"length\", from_s = 0.0, until_s = 1e9, value = 1000.0 }]",
+            "simulation.duration_s=40000",
+        ],
+    );
+    assert!(stdout.starts_with("verdict: FAILED"), "{stdout}");
+    assert!(stdout.contains("spool overrun"), "{stdout}");
+    assert!(verdict.contains("\"kind\": \"spool_overrun\""), "{verdict}");
+    let end: f64 = verdict
+        .split("\"end_s\": ")
+        .nth(1)
+        .and_then(|r| r.split(',').next())
+        .and_then(|x| x.parse().ok())
+        .unwrap();
+    assert!(end < 40_000.0, "the run went on to {end} s");
+}
+
+/// Issue 28 §3: a motor reel's run printed "injected: nothing (perfect sensors, ideal reel)".
+#[test]
+fn a_motor_reel_is_not_called_an_ideal_reel() {
+    let (_, _, faults) = fly("paper-elastic.toml", &["simulation.duration_s=60"]);
+    assert!(!faults.contains("ideal reel"), "{faults}");
+    assert!(faults.contains("reel: the motor drum"), "{faults}");
+}
+
+/// Issue 28 §3: `reel.locked = true` paid out while the lag drive decayed from l̇(0).
+#[test]
+fn a_locked_reel_with_a_lag_pays_out_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let o = Command::new(BIN)
+        .arg("run")
+        .arg(scenario("paper.toml"))
+        .arg("--out")
+        .arg(&out)
+        .args(["--set", "reel.locked=true"])
+        .args(["--set", "reel.lag_s=30"])
+        .args(["--set", "initial.length_rate_mps=2"])
+        .args(["--set", "simulation.duration_s=300"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    let lengths: Vec<f64> = history
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    assert!(lengths.iter().all(|&l| l == lengths[0]), "{lengths:?}");
+}

@@ -239,3 +239,101 @@ fn a_gain_too_fast_for_the_control_period_exits_2_and_says_why() {
         &["controller.period_s", "must be at least 0.001 s"],
     );
 }
+
+fn scenario(file: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenarios")
+        .join(file)
+}
+
+/// Issue 28 §3: a = 6 500 km (122 km of altitude) flew, paid 819 km of tether off a 40 km
+/// spool, and reported success. An orbit whose perigee is inside the atmosphere is refused.
+#[test]
+fn an_orbit_inside_the_atmosphere_exits_2() {
+    rejected(
+        &paper(),
+        &["--set", "orbit.semi_major_axis_m=6500000"],
+        &["orbit.semi_major_axis_m = 6500000", "122 km", "150 km"],
+    );
+}
+
+/// Issue 28 §3: a ≥ 1e14 m blamed `orbit.eccentricity` (0, valid). It is the semi-major axis
+/// that is refused, once, and the eccentricity is not named.
+#[test]
+fn a_semi_major_axis_beyond_the_earths_reach_blames_the_semi_major_axis() {
+    for a in ["1e14", "1e10", "1e300"] {
+        let tmp = tempfile::tempdir().unwrap();
+        let set = format!("orbit.semi_major_axis_m={a}");
+        let o = run(
+            &[
+                "run",
+                paper().to_str().unwrap(),
+                "--out",
+                tmp.path().join("o").to_str().unwrap(),
+                "--set",
+                &set,
+            ],
+            tmp.path(),
+        );
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{a}: {stderr}");
+        assert!(stderr.contains("orbit.semi_major_axis_m"), "{a}: {stderr}");
+        assert!(!stderr.contains("orbit.eccentricity ="), "{a}: {stderr}");
+        assert_eq!(
+            stderr.matches("orbit.semi_major_axis_m =").count(),
+            1,
+            "{a}: {stderr}"
+        );
+    }
+}
+
+/// Issue 28 §3: `reel.inner_rate_hz` in 100–400 passed validation, failed when the run
+/// started, printed its message twice and named no rule. The flight drive's own rule is
+/// checked with the scenario and named once.
+#[test]
+fn an_inner_rate_the_flight_drive_refuses_exits_2_naming_its_rule_once() {
+    for hz in ["100", "200", "400"] {
+        let tmp = tempfile::tempdir().unwrap();
+        let set = format!("reel.inner_rate_hz={hz}");
+        let o = run(
+            &[
+                "run",
+                scenario("paper-drive.toml").to_str().unwrap(),
+                "--out",
+                tmp.path().join("o").to_str().unwrap(),
+                "--set",
+                &set,
+            ],
+            tmp.path(),
+        );
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{hz}: {stderr}");
+        assert_eq!(
+            stderr.matches("reel.inner_rate_hz").count(),
+            1,
+            "{hz}: {stderr}"
+        );
+        assert!(stderr.contains("DriveConfig::validate"), "{hz}: {stderr}");
+        assert!(!tmp.path().join("o").exists());
+    }
+}
+
+/// Issue 28 §3: each of these hung or aborted on main; refused at once with exit 2 and the key.
+#[test]
+fn an_elastic_run_too_costly_to_fly_exits_2_naming_the_key() {
+    rejected(
+        &scenario("paper-elastic.toml"),
+        &[
+            "--set",
+            "tether.segment_length_m=0.001",
+            "--set",
+            "tether.min_stiffness_length_m=0.001",
+        ],
+        &["tether.segment_length_m = 0.001", "MAX_ELASTIC_NODES"],
+    );
+    rejected(
+        &scenario("paper-elastic.toml"),
+        &["--set", "tether.axial_stiffness_n=1e18"],
+        &["tether.axial_stiffness_n = 1e18", "MAX_ELASTIC_NODE_STEPS"],
+    );
+}

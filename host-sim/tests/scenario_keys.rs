@@ -114,7 +114,8 @@ fn rules_of<'a>(all: &'a [KeyInfo], key: &str) -> Vec<&'a str> {
 fn the_listing_states_the_rules_a_reader_relies_on() {
     let all = keys();
     for (key, fragment) in [
-        ("orbit.semi_major_axis_m", "inside the Earth"),
+        ("orbit.semi_major_axis_m", "below the simulator's 150 km"),
+        ("orbit.semi_major_axis_m", "Hill sphere"),
         ("orbit.eccentricity", "must be in [0, 0.75)"),
         ("masses.main_initial_kg", "overflows the controller's f32"),
         ("masses.sub_kg", "must be above 0"),

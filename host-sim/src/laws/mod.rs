@@ -6,7 +6,7 @@
 //!   tracking a length-rate schedule through Eq. 5a.
 //!
 //! The paper's law stays the flight core (`tss_reel::controller::Controller`, f32); these are
-//! f64 simulator code. They fly in the same closed loop ([`crate::sim::run_stepper`]) as a
+//! f64 simulator code. They fly in the same closed loop (`crate::sim::run`, which picks the law) as a
 //! [`Stepper`]: on the same sensed sample as the paper's law (sensor errors and injected faults
 //! reach them the same way), against either plant, in the same missions and Monte Carlo
 //! campaigns. Each period a law reads the sensed length, the reel's rate (the encoder's rate
@@ -28,10 +28,9 @@ pub mod tracking;
 use tss_reel::controller::{Controller, Flags, Health, Input, Output, Phase};
 use tss_reel::mass::MassModel;
 
-use crate::history::History;
 use crate::plant::Command;
 use crate::scenario::{LawName, Scenario};
-use crate::sim::{controller_config, run_stepper, SimError, Stepper};
+use crate::stepper::{controller_config, SimError, Stepper};
 use rupp::{Rupp, RuppGains};
 use tracking::{Tracking, TrackingParams};
 
@@ -277,18 +276,5 @@ impl Stepper<f32> for LawStepper {
             accel_mps2: 0.0,
             tension_n: Some(self.tension_n),
         }
-    }
-}
-
-/// Runs `sc` with the tension law `law` in the loop (the paper's law: `crate::sim::run_with`).
-pub fn run(
-    sc: &Scenario,
-    law: LawName,
-    probe_times_s: &[f64],
-    progress: &mut dyn FnMut(f64),
-) -> Result<History, SimError> {
-    match LawStepper::new(sc, law)? {
-        Some(mut stepper) => run_stepper::<f32, _>(sc, &mut stepper, probe_times_s, progress),
-        None => crate::sim::run_with::<f32>(sc, probe_times_s, progress),
     }
 }

@@ -203,6 +203,8 @@ fn histogram<DB: DrawingBackend>(
         .y_desc("runs")
         .x_labels(6)
         .x_label_formatter(&|x| sig(*x))
+        // Whole runs: no more labels than whole numbers up to the top, so none repeats.
+        .y_labels((top.floor() as usize + 1).min(10))
         .y_label_formatter(&|y| format!("{y:.0}"))
         .label_style((FONT, 14))
         .axis_desc_style((FONT, 15))
@@ -322,4 +324,26 @@ fn scatter_panel<DB: DrawingBackend>(
         ))?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 30 §5: a histogram of a few runs labelled its count axis 0, 0, 1, 1 (ticks at
+    /// halves, written as whole numbers).
+    #[test]
+    fn a_histogram_s_count_labels_do_not_repeat() {
+        let mut svg = String::new();
+        {
+            let root = SVGBackend::with_string(&mut svg, (500, 300)).into_drawing_area();
+            let vals = [(100.0, true), (200.0, true), (300.0, false)];
+            histogram(&root, HISTOGRAM_METRICS[0], &vals, None).unwrap();
+            root.present().unwrap();
+        }
+        for label in ["0", "1"] {
+            let n = svg.matches(&format!(">{label}</text>")).count();
+            assert!(n <= 1, "label {label} appears {n} times");
+        }
+    }
 }

@@ -15,21 +15,19 @@ use tss_reel::Real;
 use tss_reel::estimator;
 
 use crate::elastic::environment::Environment;
-use crate::elastic::reel_drum::DrumParams;
 use crate::elastic::tether::TetherParams;
 use crate::elastic::{
     BodyParams, ElasticParams, FlightParams, OrbitParams, ReelModel, ReelParams, Sensing,
 };
 use crate::faults::{
-    Corruption, FaultSetup, Glitch, InjectionPlan, SensedQuantity, SensorErrors, Window,
+    Corruption, FaultSetup, Glitch, InjectionPlan, ReelMechanism, SensorErrors, Window,
 };
 use crate::reel::{Reel, ReelDrive};
 use crate::sensors::{EncoderModel, LoadCellModel, SwingSensorModel};
 
 use super::{
     EncoderSection, EnvelopeSection, LoadCellSection, MonitorSection, RateSensorSection,
-    ReelModelName, ReelSection, Scenario, SensedDirection, SensorName, SwingSensorSection,
-    WindowSection,
+    ReelModelName, ReelSection, Scenario, SensedDirection, SwingSensorSection, WindowSection,
 };
 
 /// The smallest α noise the estimator is told, rad (its `Config::validate` floor): an ideal
@@ -221,19 +219,6 @@ fn swing_sensor(s: &SwingSensorSection, dropout: &[WindowSection]) -> SwingSenso
     }
 }
 
-impl From<SensorName> for SensedQuantity {
-    fn from(s: SensorName) -> Self {
-        match s {
-            SensorName::Length => Self::Length,
-            SensorName::Alpha => Self::Alpha,
-            SensorName::AlphaRate => Self::AlphaRate,
-            SensorName::OrbitRate => Self::OrbitRate,
-            SensorName::ReelRate => Self::ReelRate,
-            SensorName::Tension => Self::Tension,
-        }
-    }
-}
-
 impl From<&WindowSection> for Window {
     fn from(w: &WindowSection) -> Self {
         Self {
@@ -259,7 +244,7 @@ impl From<&Scenario> for InjectionPlan {
                 .corrupt
                 .iter()
                 .map(|c| Corruption {
-                    sensor: c.sensor.into(),
+                    sensor: c.sensor,
                     window: Window {
                         from_s: c.from_s,
                         until_s: c.until_s,
@@ -308,6 +293,14 @@ impl From<&Scenario> for FaultSetup {
             name: sc.name.clone(),
             injection: sc.into(),
             reel: (&sc.reel).into(),
+            mechanism: match sc.reel.model {
+                ReelModelName::Drive => ReelMechanism::Drive,
+                ReelModelName::Motor => ReelMechanism::Motor,
+                ReelModelName::FlightDrive => ReelMechanism::FlightDrive {
+                    inner_rate_hz: sc.reel.inner_rate_hz,
+                },
+            },
+            locked: sc.reel.locked,
             envelope: sc.envelope.to_envelope(),
         }
     }
@@ -319,16 +312,7 @@ impl From<&Scenario> for ElasticParams {
     fn from(sc: &Scenario) -> Self {
         let (t, r, e) = (&sc.tether, &sc.reel, &sc.environment);
         let orbit = Orbit::elliptic(sc.orbit.semi_major_axis_m, sc.orbit.eccentricity);
-        let drum = DrumParams {
-            radius_m: r.drum_radius_m,
-            inertia_kgm2: r.drum_inertia_kgm2,
-            viscous_nms: r.viscous_nms,
-            coulomb_nm: r.coulomb_nm,
-            static_nm: r.static_nm,
-            max_torque_nm: r.motor_max_torque_nm,
-            brake_nm: r.brake_nm,
-            speed_bandwidth_radps: r.speed_bandwidth_radps,
-        };
+        let drum = r.drum_params();
         let model = match r.model {
             ReelModelName::Motor => ReelModel::Motor(drum),
             ReelModelName::FlightDrive => ReelModel::Flight(FlightParams {

@@ -15,9 +15,13 @@ use super::rules::{num, Validator};
 use super::{nominal_value, Problem, Scenario};
 
 /// Records the first rule the flight controller's configuration breaks, if any.
+/// A key the scenario's own rules already reported is not reported again.
 pub(super) fn check(sc: &Scenario, v: &mut Validator) {
     if let Err(e) = Controller::<f32>::new(sc.controller_config::<f32>()) {
-        v.problems.push(problem(sc, &e));
+        let p = problem(sc, &e);
+        if !v.problems.iter().any(|q| q.field == p.field) {
+            v.problems.push(p);
+        }
     }
 }
 
@@ -80,6 +84,14 @@ fn scenario_key(sc: &Scenario, e: &ConfigError) -> String {
                 _ if stage == "stage1" => "stage1.band_start_m",
                 _ => "stage2.band_start_m",
             }
+        }
+        // No equilibrium with e inside its range: the orbit itself is too wide for the
+        // controller's f32 (its rate underflows), so the semi-major axis is at fault.
+        "orbit.eccentricity"
+            if e.rule == Rule::NoEquilibrium
+                && (0.0..ECCENTRICITY_LIMIT).contains(&sc.orbit.eccentricity) =>
+        {
+            "orbit.semi_major_axis_m"
         }
         // orbit.*, masses.*, stage1/2 rates, monitor.*, envelope.*: the same path.
         same => same,

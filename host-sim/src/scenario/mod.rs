@@ -41,6 +41,7 @@
 mod control;
 mod convert;
 mod core_rules;
+mod cost;
 mod envelope;
 mod environment;
 mod error;
@@ -67,6 +68,10 @@ use serde::{Deserialize, Serialize};
 pub use control::{
     ControllerSection, LawName, RuppSection, Stage1Section, Stage2Section, TrackingSection,
 };
+pub use cost::{
+    elastic_cost, ElasticCost, BYTES_PER_NODE, MAX_ELASTIC_NODES, MAX_ELASTIC_NODE_STEPS,
+    MAX_SHAPE_POINTS,
+};
 pub use envelope::EnvelopeSection;
 pub use environment::EnvironmentSection;
 pub use error::{Problem, ScenarioError};
@@ -85,13 +90,15 @@ pub use reel::{ReelModelName, ReelSection};
 pub use schema::{schema, LeafKind, Schema};
 pub use sensors::{
     CorruptSection, EncoderSection, FaultsSection, GlitchSection, LoadCellSection,
-    RateSensorSection, SensorName, SensorsSection, SwingSensorSection, WindowSection,
-    MAX_FAULT_ENTRIES,
+    RateSensorSection, SensorsSection, SwingSensorSection, WindowSection, MAX_FAULT_ENTRIES,
 };
 pub use simulation::{
     SimulationSection, MAX_HISTORY_ROWS, MAX_PLANT_STEPS, MAX_SUBSTEPS, MAX_TICKS,
 };
-pub use system::{MassesSection, OrbitSection, TetherSection, EARTH_EQUATORIAL_RADIUS_M};
+pub use system::{
+    MassesSection, OrbitSection, TetherSection, EARTH_EQUATORIAL_RADIUS_M, EARTH_HILL_RADIUS_M,
+    MIN_PERIGEE_ALTITUDE_M,
+};
 
 use rules::Validator;
 
@@ -176,12 +183,14 @@ impl Scenario {
         s.sensors.check(&mut v);
         s.faults.check(&mut v);
         s.reel.check(&mut v);
+        s.reel.check_flight_drive(s.controller.period_s, &mut v);
         s.monitor.check(&mut v);
         s.link.check(&mut v);
         s.tether.check(&mut v);
         s.plant.check(s.controller.period_s, &mut v);
         s.environment.check(&mut v);
         s.check_elastic_only(&mut v);
+        cost::check(s, &mut v);
         // The flight controller's own rules, last (it reports the first it finds).
         core_rules::check(s, &mut v);
         v.problems

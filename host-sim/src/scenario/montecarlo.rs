@@ -259,15 +259,42 @@ pub fn ignored_by_models(sc: &Scenario, field: &str) -> Option<String> {
         "tether.diameter_m",
         "tether.drag_coefficient",
     ];
+    const WHOLE_PERIODS: [&str; 4] = [
+        "simulation.duration_s",
+        "simulation.output_interval_s",
+        "plant.shape_interval_s",
+        "stage2.start_time_s",
+    ];
     let rigid = sc.plant.model == PlantModel::Rigid;
     if rigid && (ELASTIC_ONLY.contains(&field) || DRAG.contains(&field)) {
         return Some("the rigid plant (plant.model = \"rigid\") does not use it".to_string());
     }
-    if sc.reel.model == ReelModelName::Motor && LAG_DRIVE.contains(&field) {
+    if sc.reel.model != ReelModelName::Drive && LAG_DRIVE.contains(&field) {
+        return Some(format!(
+            "reel.model = {:?} flies the drum and its speed loop, not the lag drive",
+            reel_model_name(sc.reel.model)
+        ));
+    }
+    if sc.reel.model == ReelModelName::FlightDrive && field == "reel.speed_bandwidth_radps" {
         return Some(
-            "reel.model = \"motor\" flies the drum and its speed loop, not the lag drive"
-                .to_string(),
+            "reel.model = \"flight_drive\" flies the flight speed loop's own gains".to_string(),
         );
+    }
+    // Whole numbers of control periods: a continuous draw is never one, so every run would
+    // be refused (and the output interval changes what is written, not what is flown).
+    if WHOLE_PERIODS.contains(&field) {
+        return Some(
+            "it must be a whole number of control periods, which a drawn value is not".to_string(),
+        );
+    }
+    if field.starts_with("protection.") && !sc.protection.enabled {
+        return Some("protection.enabled = false".to_string());
+    }
+    if field.starts_with("sensors.alpha_rate.") && !sc.sensors.alpha_rate.enabled {
+        return Some("sensors.alpha_rate.enabled = false (no α̇ sensor is fitted)".to_string());
+    }
+    if field.starts_with("sensors.load_cell.") && !sc.sensors.load_cell.enabled {
+        return Some("sensors.load_cell.enabled = false (no load cell is fitted)".to_string());
     }
     if sc.reel.model == ReelModelName::Drive && MOTOR.contains(&field) {
         return Some(
@@ -282,6 +309,15 @@ pub fn ignored_by_models(sc: &Scenario, field: &str) -> Option<String> {
         return Some("environment.j2 and environment.drag are both false".to_string());
     }
     None
+}
+
+/// The name of a reel model as scenario files write it.
+fn reel_model_name(m: ReelModelName) -> &'static str {
+    match m {
+        ReelModelName::Drive => "drive",
+        ReelModelName::Motor => "motor",
+        ReelModelName::FlightDrive => "flight_drive",
+    }
 }
 
 /// The dispersible fields in the section of `field`, or a few examples.

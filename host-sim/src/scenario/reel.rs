@@ -3,7 +3,12 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::rules::{num, Validator};
+use tss_reel::reel_drive::{DriveConfigError, DriveRule};
+
+use crate::elastic::reel_drum::DrumParams;
+use crate::elastic::FlightParams;
+
+use super::rules::{is_positive, num, Validator};
 
 /// Which reel model flies the tether.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -177,4 +182,104 @@ impl ReelSection {
             "must be positive",
         );
     }
+}
+
+impl ReelSection {
+    /// The drum of the motor and flight reels, as the elastic plant takes it.
+    pub(super) fn drum_params(&self) -> DrumParams {
+        DrumParams {
+            radius_m: self.drum_radius_m,
+            inertia_kgm2: self.drum_inertia_kgm2,
+            viscous_nms: self.viscous_nms,
+            coulomb_nm: self.coulomb_nm,
+            static_nm: self.static_nm,
+            max_torque_nm: self.motor_max_torque_nm,
+            brake_nm: self.brake_nm,
+            speed_bandwidth_radps: self.speed_bandwidth_radps,
+        }
+    }
+
+    /// With `model = "flight_drive"`: the flight speed loop's own configuration
+    /// (`tss_reel::reel_drive::DriveConfig::validate`, built as the elastic plant builds it at
+    /// control period `period_s`) accepts this drum, encoder and inner rate. Its first broken
+    /// rule is named by the scenario key it comes from, here and not when the run starts.
+    pub(super) fn check_flight_drive(&self, period_s: f64, v: &mut Validator) {
+        let drum_ok = [
+            self.drum_radius_m,
+            self.drum_inertia_kgm2,
+            self.motor_max_torque_nm,
+        ]
+        .into_iter()
+        .all(is_positive);
+        if self.model != ReelModelName::FlightDrive
+            || !drum_ok
+            || !is_positive(period_s)
+            || self.inner_rate_hz < 100
+            || self.encoder_counts_per_rev == 0
+        {
+            return; // not flown, or reported by the rules above
+        }
+        let flight = FlightParams {
+            drum: self.drum_params(),
+            inner_rate_hz: self.inner_rate_hz,
+            counts_per_rev: self.encoder_counts_per_rev,
+            period_s,
+        };
+        if let Err(e) = flight.drive_config().validate() {
+            let (key, value) = self.flight_drive_key(&e);
+            v.check(false, key, value, &flight_drive_rule(&e));
+        }
+    }
+
+    /// The scenario key a rejected drive parameter comes from, and its value as written.
+    fn flight_drive_key(&self, e: &DriveConfigError) -> (&'static str, String) {
+        let hz = || ("reel.inner_rate_hz", num(f64::from(self.inner_rate_hz)));
+        match e.param {
+            "geometry.counts_per_motor_rev" | "geometry.gear_ratio" => (
+                "reel.encoder_counts_per_rev",
+                num(f64::from(self.encoder_counts_per_rev)),
+            ),
+            "geometry.drum_radius_m" => ("reel.drum_radius_m", num(self.drum_radius_m)),
+            "drum.inertia_kgm2" => ("reel.drum_inertia_kgm2", num(self.drum_inertia_kgm2)),
+            "drum.viscous_nm_per_radps" => ("reel.viscous_nms", num(self.viscous_nms)),
+            "drum.coulomb_nm" => ("reel.coulomb_nm", num(self.coulomb_nm)),
+            "max_torque_nm" => ("reel.motor_max_torque_nm", num(self.motor_max_torque_nm)),
+            // The rates, tick counts and counter checks follow from the inner rate.
+            _ => hz(),
+        }
+    }
+}
+
+/// The flight drive's rule `e` breaks, in words, naming its parameter.
+fn flight_drive_rule(e: &DriveConfigError) -> String {
+    let rule = match e.rule {
+        DriveRule::NotFinite => "is not finite".to_string(),
+        DriveRule::NotPositive => "must be above 0".to_string(),
+        DriveRule::Negative => "must not be negative".to_string(),
+        DriveRule::BandInverted => "must be above its lower bound".to_string(),
+        DriveRule::OutOfRange => "is outside its documented range".to_string(),
+        DriveRule::BelowMinimum => format!(
+            "is below the speed loop's {} Hz",
+            tss_reel::reel_drive::config::MIN_INNER_RATE_HZ
+        ),
+        DriveRule::TooManyCounts => format!(
+            "makes more than {} counts per drum revolution",
+            tss_reel::reel_drive::config::MAX_COUNTS_PER_DRUM_REV
+        ),
+        DriveRule::BelowMaxSpeed => {
+            "is below the drive's top speed: normal motion would read as a jump".to_string()
+        }
+        DriveRule::CounterAmbiguous => "lets the encoder's counter wrap within the gap the \
+                                        encoder check bridges at the drive's top speed, so a \
+                                        count change could not be told from a wrap"
+            .to_string(),
+        #[allow(unreachable_patterns)]
+        other => format!("breaks the rule {other:?}"),
+    };
+    format!(
+        "is refused by the flight speed loop: its {} = {} {rule} \
+         (tss_reel::reel_drive::DriveConfig::validate)",
+        e.param,
+        num(e.value)
+    )
 }

@@ -10,6 +10,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::sensors::SensedQuantity;
+
 use super::rules::{num, Validator};
 
 /// `[sensors]`: what the controller reads is the plant's truth through these models (see each
@@ -238,44 +240,12 @@ pub struct WindowSection {
     pub until_s: f64,
 }
 
-/// The sensors a `[[faults.corrupt]]` entry can hit.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum SensorName {
-    /// The length encoder.
-    Length,
-    /// The α sensor.
-    Alpha,
-    /// The α̇ sensor.
-    AlphaRate,
-    /// The orbit-rate source.
-    OrbitRate,
-    /// The reel's rate from the encoder.
-    ReelRate,
-    /// The load cell.
-    Tension,
-}
-
-impl SensorName {
-    /// The name as written in scenario files.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Self::Length => "length",
-            Self::Alpha => "alpha",
-            Self::AlphaRate => "alpha_rate",
-            Self::OrbitRate => "orbit_rate",
-            Self::ReelRate => "reel_rate",
-            Self::Tension => "tension",
-        }
-    }
-}
-
 /// `[[faults.corrupt]]`: `sensor` reads `value` during [from_s, until_s).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CorruptSection {
     /// Which sensor.
-    pub sensor: SensorName,
+    pub sensor: SensedQuantity,
     /// Start, s.
     pub from_s: f64,
     /// End (excluded), s; inf = to the end of the run.

@@ -7,8 +7,19 @@ use serde::{Deserialize, Serialize};
 
 use super::rules::{num, Validator};
 
-/// Equatorial radius of the Earth (WGS-84), m: the orbit's perigee must lie above it.
+/// Equatorial radius of the Earth (WGS-84), m: altitudes are measured from it.
 pub const EARTH_EQUATORIAL_RADIUS_M: f64 = 6_378_137.0;
+
+/// The lowest perigee altitude a scenario may fly, m: 150 km. Below it the atmosphere
+/// (2·10⁻⁹ kg/m³ at 150 km in `elastic::environment`'s table, 20 times that at 120 km) brings a
+/// satellite down within about a day, faster than a mission of the paper's 20 h can be flown;
+/// neither plant models the re-entry.
+pub const MIN_PERIGEE_ALTITUDE_M: f64 = 150_000.0;
+
+/// The radius of the Earth's Hill sphere, m: a⊕·(M⊕/3M☉)^(1/3) = 1.496·10¹¹ m × 0.01 ≈
+/// 1.5·10⁹ m. Beyond it the Sun, not the Earth, holds a satellite: the apogee a(1 + e) must
+/// lie inside it.
+pub const EARTH_HILL_RADIUS_M: f64 = 1.5e9;
 
 /// `[orbit]`
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -25,28 +36,47 @@ pub struct OrbitSection {
 }
 
 impl OrbitSection {
-    /// θ(0) finite, and the perigee a(1 − e) above the Earth's surface (a > 0 and the range
-    /// of e are the controller's rules).
+    /// θ(0) finite; the perigee a(1 − e) at least [`MIN_PERIGEE_ALTITUDE_M`] above the Earth
+    /// and the apogee a(1 + e) inside its Hill sphere ([`EARTH_HILL_RADIUS_M`]); both blame
+    /// the semi-major axis (a > 0 and the range of e are the controller's rules).
     pub(super) fn check(&self, v: &mut Validator) {
         let o = self;
         v.finite("orbit.initial_true_anomaly_rad", o.initial_true_anomaly_rad);
-        if o.semi_major_axis_m.is_finite()
+        if !(o.semi_major_axis_m.is_finite()
             && o.semi_major_axis_m > 0.0
-            && (0.0..1.0).contains(&o.eccentricity)
+            && (0.0..1.0).contains(&o.eccentricity))
         {
-            let perigee_m = o.semi_major_axis_m * (1.0 - o.eccentricity);
-            v.check(
-                perigee_m > EARTH_EQUATORIAL_RADIUS_M,
-                "orbit.semi_major_axis_m",
-                num(o.semi_major_axis_m),
-                &format!(
-                    "puts the perigee a(1 − e) = {} m (orbit.eccentricity = {}) inside the Earth \
-                     (radius {EARTH_EQUATORIAL_RADIUS_M} m)",
-                    num(perigee_m),
-                    num(o.eccentricity)
-                ),
-            );
+            return;
         }
+        let (a, e) = (o.semi_major_axis_m, o.eccentricity);
+        let perigee_m = a * (1.0 - e);
+        let altitude_m = perigee_m - EARTH_EQUATORIAL_RADIUS_M;
+        v.check(
+            altitude_m >= MIN_PERIGEE_ALTITUDE_M,
+            "orbit.semi_major_axis_m",
+            num(a),
+            &format!(
+                "puts the perigee a(1 − e) = {} m (orbit.eccentricity = {}) at {} km of \
+                 altitude, below the simulator's {} km (scenario::MIN_PERIGEE_ALTITUDE_M: the \
+                 atmosphere brings it down within a day)",
+                num(perigee_m),
+                num(e),
+                num((altitude_m / 1e3).round()),
+                num(MIN_PERIGEE_ALTITUDE_M / 1e3)
+            ),
+        );
+        let apogee_m = a * (1.0 + e);
+        v.check(
+            apogee_m <= EARTH_HILL_RADIUS_M,
+            "orbit.semi_major_axis_m",
+            num(a),
+            &format!(
+                "puts the apogee a(1 + e) = {} m beyond the Earth's Hill sphere ({} m, \
+                 scenario::EARTH_HILL_RADIUS_M): the Sun, not the Earth, would hold the orbit",
+                num(apogee_m),
+                num(EARTH_HILL_RADIUS_M)
+            ),
+        );
     }
 }
 

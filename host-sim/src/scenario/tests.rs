@@ -184,7 +184,10 @@ fn fault_injection_from_the_file_and_from_overrides() {
             until_s: 660.0
         }]
     );
-    assert_eq!(s.faults.corrupt[0].sensor, SensorName::AlphaRate);
+    assert_eq!(
+        s.faults.corrupt[0].sensor,
+        crate::sensors::SensedQuantity::AlphaRate
+    );
     assert!(s.faults.corrupt[0].value.is_nan());
     assert_eq!(
         s.faults.length_glitch,
@@ -405,8 +408,8 @@ fn every_rule_names_file_field_and_value() {
         (&["name=a/b"], "name", "\"a/b\"", "file name"),
         (&["name=.."], "name", "\"..\"", "file name"),
         (&["orbit.semi_major_axis_m=-1"], "orbit.semi_major_axis_m", "-1", "must be above 0"),
-        (&["orbit.semi_major_axis_m=6000000"], "orbit.semi_major_axis_m", "6000000", "inside the Earth"),
-        (&["orbit.eccentricity=0.2"], "orbit.semi_major_axis_m", "7078000", "inside the Earth"),
+        (&["orbit.semi_major_axis_m=6000000"], "orbit.semi_major_axis_m", "6000000", "below the simulator's 150 km"),
+        (&["orbit.eccentricity=0.2"], "orbit.semi_major_axis_m", "7078000", "below the simulator's 150 km"),
         (&["orbit.eccentricity=1"], "orbit.eccentricity", "1", "must be in [0, 0.75): beyond it no equilibrium"),
         (&["orbit.eccentricity=-0.1"], "orbit.eccentricity", "-0.1", "must be in [0, 0.75)"),
         (&["orbit.initial_true_anomaly_rad=nan"], "orbit.initial_true_anomaly_rad", "NaN", "finite"),
@@ -728,4 +731,51 @@ fn conversions_keep_the_meaning_of_the_defaults() {
     let cfg = s.controller_config::<f32>();
     assert_eq!(cfg.stage2.start_tick, Some(28_800));
     assert_eq!(cfg.envelope.max_rate_mps, 10.0);
+}
+
+/// Issue 28 §3: a campaign accepted dispersions that change nothing (the lag drive's keys
+/// under the flight drive, the protection's with the protection off, the α̇ sensor's with no
+/// α̇ sensor) and the output interval, whose drawn values are never whole periods (every run
+/// "did_not_complete"). Each is refused, with the reason.
+#[test]
+fn dispersions_that_change_nothing_are_refused() {
+    let entry = |field: &str| {
+        format!(
+            "[[montecarlo.dispersion]]\nfield = \"{field}\"\ndistribution = \"normal\"\nstd = 0.1\n"
+        )
+    };
+    let elastic = "[plant]\nmodel = \"elastic\"\n[reel]\nmodel = \"flight_drive\"\n";
+    let cases: &[(&str, &str, &str)] = &[
+        (elastic, "reel.lag_s", "flies the drum"),
+        (elastic, "reel.max_rate_mps", "flies the drum"),
+        ("", "protection.max_tension_n", "protection.enabled = false"),
+        ("", "sensors.alpha_rate.noise_std", "no α̇ sensor"),
+        (
+            "",
+            "simulation.output_interval_s",
+            "whole number of control periods",
+        ),
+        ("", "stage2.start_time_s", "whole number of control periods"),
+    ];
+    for (sections, field, why) in cases {
+        let text = format!("{BASE}{sections}{}", entry(field));
+        let e = Scenario::from_toml_str(&text, FILE, &[])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("field = \"{field}\" has no effect")) && e.contains(why),
+            "{field}: {e}"
+        );
+    }
+    // Switched on, the same dispersions are flown.
+    for (sections, field) in [
+        ("[protection]\nenabled = true\n", "protection.max_tension_n"),
+        (
+            "[sensors.alpha_rate]\nenabled = true\n",
+            "sensors.alpha_rate.noise_std",
+        ),
+    ] {
+        let text = format!("{BASE}{sections}{}", entry(field));
+        Scenario::from_toml_str(&text, FILE, &[]).unwrap_or_else(|e| panic!("{field}: {e}"));
+    }
 }
