@@ -347,7 +347,7 @@ where
         table.render()
     );
     files.push(out.write("summary.txt", |w| w.write_all(report.as_bytes()))?);
-    // The fault summary (faults.rs): printed after the report and written to faults.txt.
+    // The fault summary (`crate::faults`): printed after the report and written to faults.txt.
     let faults = crate::faults::render_fault_summary(&scenario, &history.faults);
     files.push(out.write("faults.txt", |w| w.write_all(faults.as_bytes()))?);
     let report = format!("{report}\n{faults}");

@@ -35,9 +35,11 @@ pub const MAX_ELASTIC_NODES: f64 = 1e5;
 /// the four RK4 stages of both and the feeding rule's workspace (≈ 40 f64).
 pub const BYTES_PER_NODE: f64 = 512.0;
 
-/// The most node steps of an elastic run (nodes × RK4 substeps over the whole run): 10¹¹,
-/// a few hours at the measured cost of a node step (docs/performance.md).
-pub const MAX_ELASTIC_NODE_STEPS: f64 = 1e11;
+/// The most node steps of an elastic run (nodes × RK4 substeps over the whole run): 10¹⁰,
+/// about an hour of desk time at the few tenths of a microsecond a node step costs
+/// (`tss-sim run scenarios/paper-elastic.toml`, 6·10⁶ node steps, flies in about 2 s), five
+/// times the estimate of `scenarios/paper-drive.toml`, the costliest shipped scenario.
+pub const MAX_ELASTIC_NODE_STEPS: f64 = 1e10;
 
 /// The most tether-shape points an elastic run records (shapes × nodes): 10⁷, 240 MB of
 /// 3-vectors.
@@ -371,6 +373,6 @@ mod tests {
         assert!((c.fastest_radps - 10.0).abs() < 1e-12, "{c:?}");
         // 72 000 periods of at most 10 + 1 substeps.
         assert_eq!(c.steps, 72_000.0 * 11.0);
-        assert!(c.node_steps() < MAX_ELASTIC_NODE_STEPS * 1e-3);
+        assert!(c.node_steps() < MAX_ELASTIC_NODE_STEPS * 1e-2);
     }
 }
