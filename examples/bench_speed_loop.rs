@@ -50,8 +50,8 @@ mod bench {
     /// figures are then 0.
     const TRACED: bool = option_env!("TSS_BENCH_TRACED").is_some();
 
-    /// Issue 19's budget for one inner step, checked against the worst case.
-    pub const BUDGET_INSTRUCTIONS: u32 = 200;
+    /// The ceiling for one inner step (issue 30), checked against the worst case.
+    pub const BUDGET_INSTRUCTIONS: u32 = 250;
 
     /// The test drum of `tests/reel_drive.rs`, in f32 with an f64 angle (outside the timing):
     /// J 10 % and friction 20/25 % above the loop's model, 20 N of tension.
@@ -104,18 +104,19 @@ mod bench {
     /// Everything measured over one scenario.
     pub struct Run {
         pub step: Stats<1024>,
-        states: [StateStats; 4],
+        states: [StateStats; 5],
         pub command: Stats<1024>,
     }
 
-    const STATES: [&str; 4] = ["Engaged", "Releasing", "Released", "Tripped"];
+    const STATES: [&str; 5] = ["Engaged", "Releasing", "Released", "MotorHold", "Tripped"];
 
     fn state_index(b: Brake) -> usize {
         match b {
             Brake::Engaged => 0,
             Brake::Releasing { .. } => 1,
             Brake::Released { .. } => 2,
-            Brake::Tripped(_) => 3,
+            Brake::MotorHold => 3,
+            Brake::Tripped(_) => 4,
         }
     }
 
@@ -213,7 +214,7 @@ mod bench {
                 n: 0,
                 sum: 0,
                 max: 0,
-            }; 4],
+            }; 5],
             command: Stats::new(),
         };
         run(m, &mut r, ticks, scenario);

@@ -39,6 +39,8 @@ struct Drum {
     brake_high_ticks: u32,
     /// Seized: it does not turn whatever the torque.
     jammed: bool,
+    /// The spring brake's holding torque, N m (infinite: it holds whatever the torque).
+    brake_nm: f64,
 }
 
 impl Drum {
@@ -54,6 +56,7 @@ impl Drum {
             rate_radps: 0.0,
             brake_high_ticks: 0,
             jammed: false,
+            brake_nm: f64::INFINITY,
         }
     }
 
@@ -81,20 +84,27 @@ impl Drum {
         } else {
             0
         };
-        if self.brake_high_ticks <= BRAKE_LIFT_TICKS || self.jammed {
+        let braked = self.brake_high_ticks <= BRAKE_LIFT_TICKS;
+        if self.jammed || (braked && self.brake_nm == f64::INFINITY) {
             self.rate_radps = 0.0;
             return;
         }
+        // A brake that can slip adds its torque to the friction.
+        let friction = if braked {
+            self.coulomb_nm + self.brake_nm
+        } else {
+            self.coulomb_nm
+        };
         let h = dt_s / f64::from(SUBSTEPS);
         let motor = (duty * self.max_torque_nm).clamp(-self.max_torque_nm, self.max_torque_nm);
         for _ in 0..SUBSTEPS {
             let w = self.rate_radps;
             let drive = motor + tension_n * self.radius_m - self.viscous * w;
-            let next = if w == 0.0 && drive.abs() <= self.coulomb_nm {
+            let next = if w == 0.0 && drive.abs() <= friction {
                 0.0 // stiction holds
             } else {
                 let sign = if w != 0.0 { w.signum() } else { drive.signum() };
-                let n = w + (drive - self.coulomb_nm * sign) / self.inertia_kgm2 * h;
+                let n = w + (drive - friction * sign) / self.inertia_kgm2 * h;
                 if w != 0.0 && n.signum() != w.signum() {
                     0.0
                 } else {
@@ -117,6 +127,9 @@ struct Run {
     /// The drum's count and paid-out length when the encoder was last read.
     read_counts: i64,
     read_paid_out_m: f64,
+    /// A frozen encoder: from its tick on, it counts at a fixed rate from the count it had,
+    /// whatever the drum does (tick, count, counts per tick).
+    frozen: Option<(u32, i64, f64)>,
 }
 
 impl Run {
@@ -129,7 +142,19 @@ impl Run {
             tension_n: 20.0,
             read_counts: 0,
             read_paid_out_m: 0.0,
+            frozen: None,
         }
+    }
+
+    /// Freezes the encoder from now on at `rate_mps`: its counter advances at that speed
+    /// whatever the drum does.
+    fn freeze_encoder_at(&mut self, rate_mps: f64) {
+        let m_per_count = TAU * self.drum.radius_m / self.drum.counts_per_rev;
+        self.frozen = Some((
+            self.tick,
+            self.drum.counts(),
+            rate_mps * self.dt_s / m_per_count,
+        ));
     }
 
     fn command(&mut self, rate_mps: f32, accel_mps2: f32, safe_hold: bool) {
@@ -146,9 +171,16 @@ impl Run {
     }
 
     fn input(&self) -> DriveInput {
+        let raw = match self.frozen {
+            Some((from, count, per_tick)) => {
+                let counted = count + (f64::from(self.tick - from) * per_tick).floor() as i64;
+                (counted as u32) & 0xFFFF
+            }
+            None => self.drum.raw_count(),
+        };
         DriveInput {
             tick: self.tick,
-            encoder_count: Some(self.drum.raw_count()),
+            encoder_count: Some(raw),
             tension_n: Some(self.tension_n as f32),
         }
     }
@@ -465,25 +497,52 @@ fn missing_counts_are_bridged_for_10_ticks_then_trip() {
     assert!(counted > 0 && counted == driven, "{counted} {driven}");
 }
 
+/// A seized drum under the motor's growing torque: the tension its stillness implies is one
+/// no tether pulls (the cross-checks' `NoResponse`) within a few tenths of a second, before the
+/// stall's half second at the stall duty.
 #[test]
-fn a_jammed_drum_trips_as_a_stall_after_half_a_second() {
+fn a_jammed_drum_trips_as_unresponsive_within_a_third_of_a_second() {
     let mut run = settled_at(DriveConfig::example(), 1.0);
     run.drum.jammed = true;
     let jam = run.tick;
     let tripped_at = loop {
         let out = run.tick();
         if let Brake::Tripped(f) = out.brake {
-            assert_eq!(f, DriveFault::MotorStall);
+            assert_eq!(f, DriveFault::NoResponse);
             assert_eq!(out.duty, 0.0);
-            assert!(out.faults.contains(DriveFault::MotorStall));
+            assert!(out.faults.contains(DriveFault::NoResponse));
             break out.tick;
         }
-        assert!(run.tick < jam + 2000, "no stall");
+        assert!(run.tick < jam + 2000, "no trip");
     };
-    // 500 ticks of stall, counted once the duty reached 0.9 (the PI needs a few ticks).
+    // 100 ticks of an implied tension below −15 N, counted once the observer has seen the
+    // drum stop (its 50 ms) and the PI's torque has grown past the tension's.
     let after = tripped_at - jam;
     println!("jammed drum: tripped after {after} ms");
-    assert!((500..560).contains(&after), "{after}");
+    assert!((100..330).contains(&after), "{after}");
+}
+
+/// A drive whose implied tension stays plausible (a motor weaker than the drum's breakaway
+/// friction, nothing moving) still trips as a stall after the stall ticks.
+#[test]
+fn a_motor_too_weak_to_break_the_drum_away_trips_as_a_stall() {
+    let mut cfg = DriveConfig::example();
+    // 0.1 N m of motor against 0.25 N m of friction: the duty saturates, nothing turns, and
+    // the implied tension is −1 N (plausible).
+    cfg.max_torque_nm = 0.1;
+    cfg.drum.coulomb_nm = 0.0;
+    let mut run = Run::new(cfg);
+    run.drum.max_torque_nm = 0.1;
+    run.drum.coulomb_nm = 0.25;
+    run.tension_n = 0.0;
+    run.command(1.0, 0.0, false);
+    let tripped = (0..3000).find_map(|_| match run.tick().brake {
+        Brake::Tripped(f) => Some((f, run.tick)),
+        _ => None,
+    });
+    let (fault, at) = tripped.expect("tripped");
+    assert_eq!(fault, DriveFault::MotorStall);
+    assert!((550..700).contains(&at), "{at}");
 }
 
 #[test]
@@ -630,12 +689,169 @@ fn the_length_is_the_integer_count_to_within_a_count() {
     );
 }
 
+/// Issue 28 §2: an encoder frozen at a low speed (its counter advancing at 0.01–0.05 m/s
+/// whatever the drum does) under a command above it. Before the cross-checks the integral
+/// wound up to its clamp below the stall duty and the drum ran away (42–47 m/s in 30 s, ≈ 1 km
+/// paid out, no fault). The drum's motion now implies a tension no tether can pull (the
+/// motor's torque goes unanswered), or the integral stays pinned: `NoResponse`, tripped
+/// within 0.4 s (0.1 s after a command above the frozen speed has wound the integral), the
+/// drum below 2.5 m/s, less than 0.3 m paid out, and stopped by the brake.
+#[test]
+fn a_frozen_encoder_trips_the_drive_before_the_drum_runs_away() {
+    for frozen_mps in [0.01, 0.02, 0.05] {
+        for command_mps in [0.1_f32, 0.5, 1.0] {
+            let mut run = settled_at(DriveConfig::example(), command_mps);
+            let start_m = run.drum.paid_out_m();
+            run.freeze_encoder_at(frozen_mps);
+            let frozen_at = run.tick;
+            let mut tripped = None;
+            let mut fastest_mps: f64 = 0.0;
+            for _ in 0..30_000 {
+                let out = run.tick();
+                fastest_mps = fastest_mps.max(run.drum.speed_mps().abs());
+                if let Brake::Tripped(f) = out.brake {
+                    assert_eq!(out.duty, 0.0);
+                    tripped.get_or_insert((f, run.tick - frozen_at));
+                }
+            }
+            let (fault, after) = tripped.unwrap_or_else(|| {
+                panic!("frozen at {frozen_mps} m/s under {command_mps} m/s: no trip, {fastest_mps} m/s")
+            });
+            let paid_m = run.drum.paid_out_m() - start_m;
+            println!(
+                "frozen at {frozen_mps} m/s under {command_mps} m/s: {fault:?} after {after} ms, \
+                 fastest {fastest_mps:.2} m/s, paid out {paid_m:.2} m in 30 s"
+            );
+            assert_eq!(fault, DriveFault::NoResponse);
+            assert!(after <= 400, "{after} ms");
+            assert!(fastest_mps < 2.5, "{fastest_mps} m/s");
+            assert_eq!(run.drum.speed_mps(), 0.0, "the brake holds the drum");
+            assert!(paid_m < 0.3, "{paid_m} m");
+        }
+    }
+}
+
+/// Issue 28 §2: a brake that slips while engaged. In safe hold at 20 N (2 N m at the drum)
+/// with a brake of 1 N m the drum ran to 14.6 m/s and paid out 808 m in 60 s, the brake
+/// "Engaged", no fault. Now the odometer's travel under the engaged brake beyond
+/// `brake_slip_m` (20 mm) is `BrakeSlip`, and the motor holds the drum at rest under the
+/// brake (`Brake::MotorHold`) whatever the command, until the slip is cleared.
+#[test]
+fn a_slipping_brake_is_detected_and_the_motor_holds_the_drum() {
+    let mut run = settled_at(DriveConfig::example(), 1.0);
+    run.drum.brake_nm = 1.0;
+    // Safe hold: the drum is brought to rest and the brake engages (and slips).
+    run.command(0.0, -1.0, true);
+    let mut engaged_m = None;
+    let mut held = None;
+    for _ in 0..60_000 {
+        let out = run.tick();
+        if out.brake == Brake::Engaged && engaged_m.is_none() {
+            engaged_m = Some(run.drum.paid_out_m());
+        }
+        if out.brake == Brake::MotorHold && held.is_none() {
+            assert!(out.faults.contains(DriveFault::BrakeSlip));
+            held = Some((run.tick, run.drum.paid_out_m() - engaged_m.unwrap()));
+        }
+        if held.is_some() {
+            assert_eq!(out.brake, Brake::MotorHold);
+            assert!(out.faults.contains(DriveFault::BrakeSlip));
+        }
+    }
+    let engaged_m = engaged_m.expect("the brake engaged");
+    let (at, slip_m) = held.expect("the slip is detected");
+    let total_m = run.drum.paid_out_m() - engaged_m;
+    println!(
+        "slipping brake: held by the motor at tick {at} after {:.1} mm of slip; {:.1} mm in 60 s, \
+         drum at {:.4} m/s",
+        slip_m * 1e3,
+        total_m * 1e3,
+        run.drum.speed_mps()
+    );
+    assert!(slip_m < 0.03, "{slip_m} m");
+    assert!(total_m < 0.05, "{total_m} m");
+    assert!(run.drum.speed_mps().abs() < 1e-3);
+    // A moving command does not release the hold; clearing it engages the brake again.
+    run.command(1.0, 1.0, false);
+    for _ in 0..1000 {
+        assert_eq!(run.tick().brake, Brake::MotorHold);
+    }
+    assert_eq!(run.drive.clear_trip(), Some(DriveFault::BrakeSlip));
+    assert_eq!(run.drive.brake(), Brake::Engaged);
+    // A brake that holds is never taken for a slipping one.
+    let mut run = settled_at(DriveConfig::example(), 1.0);
+    run.command(0.0, -1.0, true);
+    for _ in 0..10_000 {
+        assert!(run.tick().faults.is_empty());
+    }
+    assert_eq!(run.drive.brake(), Brake::Engaged);
+}
+
+/// Issue 28 §2: a load cell reading 199 N against a true 20 N (inside its range) held the drum
+/// at 0.14 m/s for a 1 m/s command, no fault. The tension the drum's motion implies under the
+/// motor's torque (≈ 20 N) disagrees with it: `TensionMismatch` within half a second, the load
+/// cell is dropped from the feed-forward (the integral carries the load) and the drum follows
+/// the command again.
+#[test]
+fn a_load_cell_reading_ten_times_the_tension_is_dropped_and_the_drum_follows() {
+    let mut run = settled_at(DriveConfig::example(), 0.5);
+    run.command(1.0, 1.0, false);
+    let start = run.tick;
+    let mut detected = None;
+    for _ in 0..5000 {
+        let mut input = run.input();
+        input.tension_n = Some(199.0);
+        let out = run.tick_with(input);
+        assert!(!matches!(out.brake, Brake::Tripped(_)), "{out:?}");
+        if out.faults.contains(DriveFault::TensionMismatch) && detected.is_none() {
+            detected = Some((run.tick - start, out.implied_tension_n));
+        }
+    }
+    let (after, implied_n) = detected.expect("the mismatch is found");
+    println!(
+        "load cell 199 N against 20 N: TensionMismatch after {after} ms (implied {implied_n:.1} N); \
+         drum at {:.3} m/s for 1 m/s",
+        run.drum.speed_mps()
+    );
+    assert!(after <= 500, "{after} ms");
+    assert!(!run.drive.load_cell_trusted());
+    assert_eq!(run.drive.output().tension_n, 0.0);
+    assert!(
+        (run.drum.speed_mps() - 1.0).abs() < 0.01,
+        "{}",
+        run.drum.speed_mps()
+    );
+    let implied = f64::from(run.drive.output().implied_tension_n);
+    assert!((implied - 20.0).abs() < 5.0, "{implied} N");
+    // Trusted again once cleared.
+    assert_eq!(run.drive.clear_trip(), None);
+    assert!(run.drive.load_cell_trusted());
+}
+
+/// The cross-checks raise nothing on a healthy drive: the law's ramps both ways, through the
+/// model's mismatch (10 % inertia, 20 % / 25 % friction), at every tension the motor can hold.
+#[test]
+fn the_cross_checks_are_quiet_on_a_healthy_drive() {
+    for tension_n in [-5.0, 0.0, 10.0, 20.0] {
+        let mut run = Run::new(DriveConfig::example());
+        run.tension_n = tension_n;
+        for (rate, accel) in [(5.0, 5.0), (15.0, 5.0), (-3.0, -5.0), (0.0, 5.0)] {
+            run.command(rate, accel, false);
+            for _ in 0..5000 {
+                let out = run.tick();
+                assert!(out.faults.is_empty(), "{tension_n} N, {rate} m/s: {out:?}");
+            }
+        }
+        assert!(run.drive.load_cell_trusted());
+    }
+}
+
 #[test]
 fn every_invalid_parameter_is_named() {
     let ok = DriveConfig::example();
     assert_eq!(ok.validate(), Ok(()));
     type Breaker = fn(&mut DriveConfig);
-    let cases: [(&str, DriveRule, Breaker); 14] = [
+    let cases: [(&str, DriveRule, Breaker); 18] = [
         ("inner_rate_hz", DriveRule::BelowMinimum, |c| {
             c.inner_rate_hz = 50
         }),
@@ -679,6 +895,20 @@ fn every_invalid_parameter_is_named() {
         }),
         ("faults.max_tension_n", DriveRule::BandInverted, |c| {
             c.faults.max_tension_n = -10.0
+        }),
+        (
+            "faults.observer_bandwidth_radps",
+            DriveRule::OutOfRange,
+            |c| c.faults.observer_bandwidth_radps = 600.0,
+        ),
+        ("faults.tension_mismatch_n", DriveRule::NotPositive, |c| {
+            c.faults.tension_mismatch_n = 0.0
+        }),
+        ("faults.no_response_ticks", DriveRule::NotPositive, |c| {
+            c.faults.no_response_ticks = 0
+        }),
+        ("faults.brake_slip_m", DriveRule::NotFinite, |c| {
+            c.faults.brake_slip_m = f32::INFINITY
         }),
     ];
     for (param, rule, break_it) in cases {

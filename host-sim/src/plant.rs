@@ -363,6 +363,11 @@ pub trait Plant {
     fn shape(&self) -> Option<Vec<[f64; 3]>> {
         None
     }
+    /// The faults the reel's flight speed loop reported since the last call (the union of its
+    /// inner ticks'; none for a plant without one), for the outer controller's health.
+    fn take_drive_faults(&mut self) -> tss_reel::reel_drive::DriveFaults {
+        tss_reel::reel_drive::DriveFaults::NONE
+    }
 }
 
 /// The rigid plant flying: Eq. 5's state, its reel drive (ideal, or lagging and saturating),

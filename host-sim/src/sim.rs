@@ -147,10 +147,12 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
         };
         last_length_m = Some(seen.length_m);
         let sensed = injector.sense(tick, t_s, &truth);
-        let out = match sensed {
-            Sensed::Sample(r) => stepper.step(tick, Some(&input(tick, &r)))?,
-            Sensed::Missing => stepper.step(tick, None)?,
+        // The flight drive's faults over the period that ended reach the outer health.
+        let reading = match sensed {
+            Sensed::Sample(r) => Some(input(tick, &r)),
+            Sensed::Missing => None,
         };
+        let out = stepper.step_with_drive(tick, reading.as_ref(), plant.take_drive_faults())?;
         let command = stepper.reel_command(&out);
         let obs = plant.observe(&command);
         summary.record(

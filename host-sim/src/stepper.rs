@@ -7,6 +7,7 @@ use crate::elastic::ElasticError;
 use crate::plant::Command;
 use crate::scenario::Scenario;
 use tss_reel::controller::{Config, ConfigError, Controller, Input, Output};
+use tss_reel::reel_drive::DriveFaults;
 use tss_reel::Real;
 
 /// Why a run could not be completed.
@@ -74,6 +75,20 @@ pub trait Stepper<T> {
     /// One control period: `input` is the sensed sample, `None` when none arrived (a dropout).
     fn step(&mut self, tick: u32, input: Option<&Input<T>>) -> Result<Output<T>, SimError>;
 
+    /// One control period whose reel drive reported `drive` over the period that ended (the
+    /// flight speed loop's faults, `Plant::take_drive_faults`), as the board's outer step
+    /// takes them. The flight controller maps them onto its health
+    /// (`Controller::step_with_drive`); a stepper with no use for them flies [`Stepper::step`].
+    fn step_with_drive(
+        &mut self,
+        tick: u32,
+        input: Option<&Input<T>>,
+        drive: DriveFaults,
+    ) -> Result<Output<T>, SimError> {
+        let _ = drive;
+        self.step(tick, input)
+    }
+
     /// The reel command of the period `out` was decided for: the rate command and its
     /// acceleration (the paper's law); a tension law (`crate::laws`) commands a tension.
     fn reel_command(&self, out: &Output<T>) -> Command
@@ -94,5 +109,14 @@ impl<T: Real> Stepper<T> for Controller<T> {
             Some(x) => *Controller::step(self, x),
             None => *self.step_missing(tick),
         })
+    }
+
+    fn step_with_drive(
+        &mut self,
+        tick: u32,
+        input: Option<&Input<T>>,
+        drive: DriveFaults,
+    ) -> Result<Output<T>, SimError> {
+        Ok(*Controller::step_with_drive(self, tick, input, drive))
     }
 }

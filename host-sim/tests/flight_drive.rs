@@ -60,6 +60,31 @@ fn tracking_and_saturation_follow_the_motor_torque() {
     assert_eq!(weak.released_ticks, 0, "{weak:?}");
 }
 
+/// A drive trip reaches the outer controller's health, as on the board (issue 28 §2: before,
+/// host-sim never called `Controller::step_with_drive`, and the weak motor's `MotorStall`
+/// trip flew 3.4 m/s RMS of tracking error, slack for the whole run, "faults raised: none",
+/// health nominal): the controller goes to safe hold in the period after the trip and stays
+/// there (the trip is never cleared), and the summary names the fault.
+#[test]
+fn a_drive_trip_puts_the_outer_controller_in_safe_hold() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper-drive.toml");
+    let sets = [
+        "simulation.duration_s=60".to_string(),
+        "reel.motor_max_torque_nm=0.06".to_string(),
+    ];
+    let sc = Scenario::load(path, &sets).expect("paper-drive loads");
+    let h = tss_sim::sim::run(&sc, &[], &mut |_| {}).expect("the mission flies");
+    let f = &h.faults;
+    assert_eq!(
+        f.final_health,
+        Some(tss_reel::controller::Health::SafeHold),
+        "{f:?}"
+    );
+    assert!(f.safe_hold_s >= 55.0, "{} s of safe hold", f.safe_hold_s);
+    let text = summarize(&sc, &h).render();
+    assert!(!text.contains("faults raised: none"), "{text}");
+}
+
 /// The reel pays out at l̇(0) when the sub-satellite leaves (the drive spun up before t = 0,
 /// `FlightDrum::spin_up`), so the tether stays taut: the separation follows the paid-out
 /// length and the tension stays positive. (Started braked, the drum held the tether for the

@@ -7,14 +7,16 @@
 //! [`Controller::step_with_drive`] with the period's sample. The mapping is
 //! [`DriveFault::outer_reaction`](crate::reel_drive::DriveFault::outer_reaction):
 //!
-//! - [`OuterReaction::Report`]: the sample is used as it is (the fault is telemetry);
+//! - [`OuterReaction::Report`]: the sample is used as it is (the fault is telemetry: the
+//!   caller's own error, or a load cell the drive no longer uses);
 //! - [`OuterReaction::Degrade`] (encoder jump or missing, duty saturated too long, tension out
 //!   of range): the period is a missing sample, as [`Controller::step_missing`]: the controller
 //!   coasts on its last command (`Health::Degraded`) and goes to `Health::SafeHold` through its
 //!   leaky counter if the faults persist;
-//! - [`OuterReaction::SafeHold`] (stall, refused actuator: the drive tripped): safe hold at
-//!   once, its zero command ramped as usual, and every tripped period starts the recovery
-//!   count again.
+//! - [`OuterReaction::SafeHold`] (stall, a drum that does not answer the torque, refused
+//!   actuator: the drive tripped; a slipping brake: the motor holds the drum): safe hold at
+//!   once, its zero command ramped as usual, and every such period starts the recovery count
+//!   again.
 
 use crate::real::Real;
 use crate::reel_drive::{DriveFaults, OuterReaction, RateCommand};

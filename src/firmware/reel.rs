@@ -121,6 +121,7 @@ impl<'a> Reel<'a> {
             Brake::Engaged => "engaged",
             Brake::Releasing { .. } => "releasing",
             Brake::Released { .. } => "released",
+            Brake::MotorHold => "motor-hold",
             Brake::Tripped(_) => "tripped",
         };
         defmt::info!(

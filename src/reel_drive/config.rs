@@ -108,6 +108,21 @@ pub struct FaultLimits {
     pub min_tension_n: f32,
     /// Highest plausible tension, N (above: overload).
     pub max_tension_n: f32,
+    /// Bandwidth of the observer of the tension the drum's motion implies (the generalised
+    /// momentum observer of the drive's cross-checks, see the module docs of
+    /// [`SpeedLoop`](super::SpeedLoop)), rad/s; times the tick at most 1/2.
+    pub observer_bandwidth_radps: f32,
+    /// How far the implied tension may lie from the load cell's reading, or beyond the
+    /// plausible range, before the two disagree, N.
+    pub tension_mismatch_n: f32,
+    /// Ticks a disagreement, or an integral pinned at its clamp, must last before it is a fault
+    /// ([`DriveFault::NoResponse`](super::DriveFault::NoResponse),
+    /// [`DriveFault::TensionMismatch`](super::DriveFault::TensionMismatch); at most
+    /// [`MAX_COUNTED_TICKS`]).
+    pub no_response_ticks: u32,
+    /// Travel of the drum with the brake engaged that is a slipping brake, m
+    /// ([`DriveFault::BrakeSlip`](super::DriveFault::BrakeSlip)).
+    pub brake_slip_m: f32,
 }
 
 /// Everything that defines a reel drive. Validated once by
@@ -150,7 +165,11 @@ impl DriveConfig {
     /// jump is a count faster than 20 m/s (1304 counts a tick), and 10 ticks without an
     /// accepted count trip the drive (11 × 1304 < 2¹⁵, so the 16-bit counter stays
     /// unambiguous); stall: duty ≥ 0.9 below 2 cm/s for 0.5 s; saturation reported after 2 s;
-    /// tension plausible in [−5, 200] N.
+    /// tension plausible in [−5, 200] N; the implied tension observed at 20 rad/s (50 ms), and
+    /// a disagreement of 20 N (2 N m at the drum, 40 % of the motor: ten times the feed-forward's
+    /// friction error and the inertia's at 5 m/s²) or a pinned integral for 0.25 s a fault; a
+    /// slipping brake after 20 mm of travel with the brake engaged (1 304 counts; an engaged
+    /// brake allows none).
     pub fn example() -> Self {
         Self {
             inner_rate_hz: 1000,
@@ -190,6 +209,10 @@ impl DriveConfig {
                 saturation_ticks: 2000,
                 min_tension_n: -5.0,
                 max_tension_n: 200.0,
+                observer_bandwidth_radps: 20.0,
+                tension_mismatch_n: 10.0,
+                no_response_ticks: 100,
+                brake_slip_m: 0.02,
             },
         }
     }
@@ -311,6 +334,20 @@ impl DriveConfig {
                 DriveRule::BandInverted,
             ));
         }
+        positive(
+            "faults.observer_bandwidth_radps",
+            f.observer_bandwidth_radps,
+        )?;
+        if f.observer_bandwidth_radps * self.tick_s() > 0.5 {
+            return Err(DriveConfigError::new(
+                "faults.observer_bandwidth_radps",
+                f.observer_bandwidth_radps,
+                DriveRule::OutOfRange,
+            ));
+        }
+        positive("faults.tension_mismatch_n", f.tension_mismatch_n)?;
+        counted_ticks("faults.no_response_ticks", f.no_response_ticks)?;
+        positive("faults.brake_slip_m", f.brake_slip_m)?;
         Ok(())
     }
 }

@@ -69,12 +69,8 @@ pub struct Odometer {
 }
 
 /// The total at `last_tick` and the window's change at the last accepted reading: what the
-/// speed and a tick without an accepted reading need, kept rather than read back from the
-/// ring. A tick without an accepted reading predicts its total from them and holds the speed
-/// (the ring's three loads and their indices made such a tick, an encoder jump or a missing
-/// count, 25 instructions longer than a nominal one: every fault branch of one step 219 →
-/// 208, for 3 more on the nominal step, mission mean 158.7 → 161.7, exact,
-/// `scripts/bench-target` with `TSS_BENCH_EXACT=1`).
+/// speed and a tick without an accepted reading need. A tick without an accepted reading
+/// predicts its total from them and holds the speed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Window {
     /// The total at `last_tick`, modulo 2³² (the ring's slot of `last_tick`).
@@ -125,11 +121,8 @@ impl Odometer {
     }
 
     /// [`update`](Self::update) for the tick after the last update's, or after the ticks
-    /// [`skip`](Self::skip) gave their totals (the speed loop's step knows the gap, and
-    /// tells an overrun apart once, with its test of the gap against the encoder trip's:
-    /// against this function's own test, every fault branch of one step 213 → 205, the
-    /// mission's worst 196 → 189 and mean 166.9 → 159.1, exact, `scripts/bench-target` with
-    /// `TSS_BENCH_EXACT=1`). Returns the drum speed after it as well
+    /// [`skip`](Self::skip) gave their totals (the speed loop's step knows the gap, and tells
+    /// an overrun apart once). Returns the drum speed after it as well
     /// ([`speed_mps`](Self::speed_mps)).
     pub(super) fn update_next(
         &mut self,
@@ -159,10 +152,7 @@ impl Odometer {
     }
 
     /// Gives the `skipped` ticks after the last update their predicted totals (ticks skipped
-    /// by an overrun). Out of line and cold: an overrun is rare, and its loop kept inline costs
-    /// the nominal step registers.
-    #[cold]
-    #[inline(never)]
+    /// by an overrun).
     pub(super) fn skip(&mut self, skipped: u32) {
         for _ in 0..skipped.min(RING as u32) {
             self.last_tick = self.last_tick.wrapping_add(1);
@@ -199,9 +189,6 @@ impl Odometer {
         if change.unsigned_abs() > allowed {
             return Err(CountFault::Jump);
         }
-        // (In place, without writing the `Some` again: the speed loop's step 5 instructions
-        // less on the mission's worst path, 194 → 189, and 5.7 on the mean, `scripts/bench-target`
-        // with `TSS_BENCH_EXACT=1`.)
         *last = Accepted { raw, tick };
         self.total_counts = self.total_counts.wrapping_add(i64::from(change));
         Ok(())
@@ -214,11 +201,9 @@ impl Odometer {
     /// outer loop's length sensor.
     ///
     /// Every slot of the window's ring then holds the total, and keeps holding it until the
-    /// next reading (the reference) is accepted, so that the speed restarts from 0 there; the
-    /// ring is filled here, outside the step, rather than at that reading: the fill is 16
-    /// stores in a loop, 64 instructions, which made the reference reading's step the worst of
-    /// all (208 instructions, exact, `scripts/bench-target` with `TSS_BENCH_EXACT=1`; the
-    /// construction's zeros are the first reference's total).
+    /// next reading (the reference) is accepted, so that the speed restarts from 0 there (the
+    /// ring is filled here, outside the step; the construction's zeros are the first
+    /// reference's total).
     pub fn resync(&mut self) {
         self.accepted = None;
         self.totals = [self.total_counts as u32; RING];

@@ -9,6 +9,9 @@
 //! | brake | brake released (coil energised) | brake engaged (spring-applied: a dead MCU or a cut wire brakes) |
 //! | enable | motor driver enabled | driver off (no torque) |
 //!
+//! The motor is enabled with the brake released, or with it engaged while the motor holds the
+//! drum against a slipping brake ([`super::Brake::MotorHold`]).
+//!
 //! embedded-hal 1.0 has no encoder or ADC traits, so the quadrature counter and the load cell
 //! are small traits of our own in the style of [`crate::hal`] (associated error with a
 //! [`kind`](Error::kind), fallible, blanket `&mut T`). A failed read is a missing sample for the
@@ -191,9 +194,9 @@ where
         (self.speed, self.encoder, self.load_cell, self.pins)
     }
 
-    /// Sets the outputs for `out`: with the motor enabled, enable and brake released, then
-    /// direction (after a zero duty if it reverses) and duty; otherwise duty 0, driver off,
-    /// brake engaged, in that order.
+    /// Sets the outputs for `out`: with the motor enabled, enable, the brake (released, or
+    /// engaged while the motor holds a slipping brake), then direction (after a zero duty if
+    /// it reverses) and duty; otherwise duty 0, driver off, brake engaged, in that order.
     fn apply(&mut self, out: &DriveOutput) -> Result<(), ActuatorError> {
         if !out.brake.motor_enabled() {
             return self.safe_state();
@@ -203,7 +206,7 @@ where
             .set_high()
             .map_err(|e| ActuatorError::Enable(embedded_hal::digital::Error::kind(&e)))?;
         p.brake
-            .set_high()
+            .set_state(out.brake.brake_released().into())
             .map_err(|e| ActuatorError::Brake(embedded_hal::digital::Error::kind(&e)))?;
         let paying_out = out.duty >= 0.0;
         if self.paying_out != Some(paying_out) {

@@ -5,7 +5,8 @@
 //! The drum obeys J ω̇ = τ + T r − b ω − c sgn ω (pay-out positive, as
 //! [`super::DrumModel`]), with stiction at rest (a drum at rest stays there while
 //! |τ + T r| ≤ c), a motor torque τ = duty × τ_max in the direction pin's sense while the
-//! driver is enabled, and a spring brake that holds the drum still while its pin is low. It is
+//! driver is enabled, and a spring brake that adds [`SimDrum::brake_nm`] to the friction
+//! while its pin is low (infinite, as built: it holds the drum whatever the torque). It is
 //! deliberately not the speed loop's own model: [`SimDrum::mismatched`] has 10 % more inertia
 //! and 20 % / 25 % more viscous / Coulomb friction than the drive feeds forward (as the host
 //! tests' drum). The encoder counts the drum's angle as a wrapping hardware counter, the angle
@@ -43,6 +44,8 @@ pub struct SimDrum {
     pub encoder_bits: u32,
     /// The tether's pull at the reel, N.
     pub tension_n: f32,
+    /// The brake's holding torque, N m (`f32::INFINITY`: it never slips).
+    pub brake_nm: f32,
     /// Integration substeps per [`SimDrum::advance`].
     pub substeps: u32,
     /// Drum rate, rad/s (pay-out positive).
@@ -76,6 +79,7 @@ impl SimDrum {
             counts_per_rev: cfg.geometry.counts_per_drum_rev() as f32,
             encoder_bits: cfg.geometry.encoder_bits,
             tension_n,
+            brake_nm: f32::INFINITY,
             substeps: 4,
             rate_radps: 0.0,
             counts: 0,
@@ -124,7 +128,12 @@ impl SimDrum {
 
     /// `dt_s` of motion under the outputs as they are set now.
     pub fn advance(&mut self, dt_s: f32) {
-        if !self.brake_released {
+        let friction_nm = if self.brake_released {
+            self.coulomb_nm
+        } else {
+            self.coulomb_nm + self.brake_nm
+        };
+        if !friction_nm.is_finite() {
             self.rate_radps = 0.0;
             return;
         }
@@ -133,15 +142,15 @@ impl SimDrum {
         let counts_per_rad = self.counts_per_rev / TAU;
         for _ in 0..self.substeps.max(1) {
             let w = self.rate_radps;
-            let next = if w == 0.0 && drive_nm.abs() <= self.coulomb_nm {
-                // Stiction: the drum stays at rest.
+            let next = if w == 0.0 && drive_nm.abs() <= friction_nm {
+                // Stiction (and the brake): the drum stays at rest.
                 0.0
             } else {
                 let sense = if w != 0.0 { w } else { drive_nm };
                 let coulomb = if sense > 0.0 {
-                    self.coulomb_nm
+                    friction_nm
                 } else {
-                    -self.coulomb_nm
+                    -friction_nm
                 };
                 let accel =
                     (drive_nm - self.viscous_nm_per_radps * w - coulomb) / self.inertia_kgm2;
@@ -328,6 +337,27 @@ mod tests {
         for _ in 0..1000 {
             d.advance(1e-3);
         }
+        assert_eq!(d.speed_mps(), 0.0);
+    }
+
+    #[test]
+    fn a_weak_brake_slips_under_a_torque_beyond_it() {
+        // 20 N at 0.1 m is 2 N m: a 1 N m brake (with 0.2 N m of friction) slips, and the
+        // drum accelerates at (2 − 1.2) / J, less its viscous friction (1 % by 0.1 s).
+        let mut d = SimDrum::matching(&DriveConfig::example(), 20.0);
+        d.brake_nm = 1.0;
+        for _ in 0..100 {
+            d.advance(1e-3);
+        }
+        let expect = 0.8 / d.inertia_kgm2 * 0.1 * d.radius_m;
+        assert!(
+            (d.speed_mps() - expect).abs() < 0.02 * expect,
+            "{}",
+            d.speed_mps()
+        );
+        let mut d = SimDrum::matching(&DriveConfig::example(), 20.0);
+        d.brake_nm = 2.0;
+        d.advance(1e-3);
         assert_eq!(d.speed_mps(), 0.0);
     }
 

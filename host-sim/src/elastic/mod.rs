@@ -897,6 +897,14 @@ impl Plant for ElasticPlant {
         ElasticPlant::is_finite(self)
     }
 
+    fn take_drive_faults(&mut self) -> tss_reel::reel_drive::DriveFaults {
+        self.flight
+            .as_mut()
+            .map_or(tss_reel::reel_drive::DriveFaults::NONE, |(f, _)| {
+                f.take_faults()
+            })
+    }
+
     fn shape(&self) -> Option<Vec<[f64; 3]>> {
         Some(self.shape_orbit_frame())
     }

@@ -177,6 +177,8 @@ pub struct FlightDrum {
     tick: u32,
     substeps: u32,
     figures: DriveFigures,
+    /// The drive's faults since they were last taken ([`FlightDrum::take_faults`]).
+    faults: tss_reel::reel_drive::DriveFaults,
 }
 
 /// What the flight drive did over the periods flown: tracking, saturation, tension, faults.
@@ -281,7 +283,14 @@ impl FlightDrum {
                 tension_range_n: (f64::INFINITY, f64::NEG_INFINITY),
                 ..DriveFigures::default()
             },
+            faults: tss_reel::reel_drive::DriveFaults::NONE,
         })
+    }
+
+    /// The union of the drive's faults over the ticks since the last call (a law period's,
+    /// for `Controller::step_with_drive`, as the board hands them to the outer step).
+    pub fn take_faults(&mut self) -> tss_reel::reel_drive::DriveFaults {
+        std::mem::replace(&mut self.faults, tss_reel::reel_drive::DriveFaults::NONE)
     }
 
     /// Drum surface speed, m/s.
@@ -344,6 +353,7 @@ impl FlightDrum {
         f.ticks += 1;
         f.saturated_ticks += u64::from(out.saturated);
         f.fault_bits |= out.faults.bits();
+        self.faults = self.faults.union(out.faults);
         self.tick = self.tick.wrapping_add(1);
         if matches!(out.brake, tss_reel::reel_drive::Brake::Released { .. }) {
             let error = speed_mps - f64::from(out.ref_rate_mps);
@@ -384,6 +394,7 @@ impl FlightDrum {
             tension_range_n: (f64::INFINITY, f64::NEG_INFINITY),
             ..DriveFigures::default()
         };
+        self.faults = tss_reel::reel_drive::DriveFaults::NONE;
         self.angle_counts / self.counts_per_rad * self.params.radius_m
     }
 
