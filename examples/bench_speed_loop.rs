@@ -2,20 +2,23 @@
 //!
 //! Flies `tss_reel::reel_drive::SpeedLoop` (the example reel, 1 kHz) against a small drum
 //! model and prints, with defmt, how many instructions one [`SpeedLoop::step`] takes (median,
-//! 99th percentile, worst, per brake state) against issue 19's budget of 200, and what a
+//! 99th percentile, worst, per brake state) against the ceiling of 250 (issue 30), and what a
 //! [`SpeedLoop::set_command`] (once a law period) and a [`SpeedLoop::paid_out_m`] (telemetry)
 //! cost. The inputs visit every branch of the step:
 //!
 //! 1. `mission`: brake release, the law's 0.5 m/s² ramp to 5 m/s, a hold, a stop and the
 //!    brake engaging at rest (20 000 ticks);
 //! 2. `faults`: a saturated 0.5 → 10 m/s step, a one-tick encoder jump, missing counts, bad
-//!    tension readings, a non-finite command, a jammed drum until the stall trip, a cleared
+//!    tension readings, a load cell reading ten times the tension (dropped until the trip's
+//!    clearing), a non-finite command, a jammed drum until its trip (`NoResponse`), a cleared
 //!    trip, a counter that lost counts for good until the encoder trip;
 //! 3. `worst`: every arm's worst path, the fault branches of one step together: encoder jumps
-//!    (one tick in three) and an overload tension on a jammed drum, through the stall's count
-//!    and trip, the tripped state, a brake release, the brake's rest count while the stall and
-//!    saturation counters run, a release on the jammed drum under the overload (the stall's
-//!    and the saturation's counts on the release's tick), and the encoder trip (6 000 ticks).
+//!    (one tick in three) and an overload tension on a jammed drum, through the trip, the
+//!    tripped state, a brake release, the brake's rest count while the stall and saturation
+//!    counters run, a release on the jammed drum under the overload, and the encoder trip
+//!    (6 000 ticks);
+//! 4. `brake`: safe hold at rest under the tension, the brake weakened until it slips, the
+//!    slip found and the motor holding the drum under the brake (5 000 ticks).
 //!
 //! Run it (after `scripts/setup`) with
 //!
@@ -59,6 +62,8 @@ mod bench {
         rate_radps: f32,
         angle_counts: f64,
         jammed: bool,
+        /// The engaged brake holds 1 N m only (the tension's 2 N m makes it slip).
+        weak_brake: bool,
     }
 
     const COUNTS_PER_RAD: f64 = 40_960.0 / core::f64::consts::TAU;
@@ -66,17 +71,18 @@ mod bench {
 
     impl Drum {
         fn advance(&mut self, duty: f32, released: bool, tension_n: f32) {
-            if !released || self.jammed {
+            if self.jammed || (!released && !self.weak_brake) {
                 self.rate_radps = 0.0;
                 return;
             }
+            let friction = if released { 0.25 } else { 1.25 };
             let w = self.rate_radps;
             let drive = 5.0 * duty + 0.1 * tension_n - 0.012 * w;
-            let next = if w == 0.0 && libm::fabsf(drive) <= 0.25 {
+            let next = if w == 0.0 && libm::fabsf(drive) <= friction {
                 0.0
             } else {
                 let sign = if w != 0.0 { w } else { drive };
-                let coulomb = if sign > 0.0 { 0.25 } else { -0.25 };
+                let coulomb = if sign > 0.0 { friction } else { -friction };
                 let n = w + (drive - coulomb) / 0.055 * DT_S;
                 if w != 0.0 && (n > 0.0) != (w > 0.0) {
                     0.0
@@ -124,6 +130,10 @@ mod bench {
     pub enum Action {
         None,
         Command(f32, f32),
+        /// A command in safe hold (rate, acceleration).
+        Hold(f32, f32),
+        /// The brake becomes one that slips under the tension.
+        WeakenBrake,
         Jam,
         /// Jams the drum and commands (rate, acceleration) in the same tick.
         JamAndCommand(f32, f32),
@@ -148,6 +158,7 @@ mod bench {
             rate_radps: 0.0,
             angle_counts: 0.0,
             jammed: false,
+            weak_brake: false,
         };
         for tick in 0..ticks {
             let t = scenario(tick);
@@ -160,11 +171,11 @@ mod bench {
             };
             match action {
                 Action::None | Action::JamAndCommand(..) => {}
-                Action::Command(rate_mps, accel_mps2) => {
+                Action::Command(rate_mps, accel_mps2) | Action::Hold(rate_mps, accel_mps2) => {
                     let cmd = RateCommand {
                         rate_mps,
                         accel_mps2,
-                        safe_hold: false,
+                        safe_hold: matches!(action, Action::Hold(..)),
                     };
                     let mut copies: [SpeedLoop; K] = core::array::from_fn(|_| drive.clone());
                     let cost = m.per_call(&mut copies, |d| d.set_command(black_box(cmd), tick));
@@ -172,6 +183,7 @@ mod bench {
                     let _ = drive.set_command(cmd, tick);
                 }
                 Action::Jam => drum.jammed = true,
+                Action::WeakenBrake => drum.weak_brake = true,
                 Action::ClearTrip => {
                     drive.clear_trip();
                     drum.jammed = false;
@@ -322,6 +334,8 @@ fn main() -> ! {
             5201 => t.tension_n = None,
             5202 => t.tension_n = Some(1e6),
             5203 => t.tension_n = Some(-1e6),
+            // A load cell reading ten times the tension: dropped (until the trip's clearing).
+            5300..=5799 => t.tension_n = Some(199.0),
             // A counter that lost counts for good: jumps until the encoder trip.
             11_000.. => t.count_offset = 20_000,
             _ => {}
@@ -362,6 +376,16 @@ fn main() -> ! {
             t.count_offset = 20_000;
         }
         t
+    });
+    // A brake that slips: safe hold at rest under the tension, the slip found, the motor
+    // holding the drum under the brake.
+    bench::measure(&meter, "brake", 5_000, |tick| {
+        quiet(match tick {
+            0 => Action::Command(1.0, 1.0),
+            1000 => Action::Hold(0.0, -1.0),
+            1500 => Action::WeakenBrake,
+            _ => Action::None,
+        })
     });
     bench::paid_out(&meter);
 

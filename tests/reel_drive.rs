@@ -804,7 +804,7 @@ fn a_load_cell_reading_ten_times_the_tension_is_dropped_and_the_drum_follows() {
         let out = run.tick_with(input);
         assert!(!matches!(out.brake, Brake::Tripped(_)), "{out:?}");
         if out.faults.contains(DriveFault::TensionMismatch) && detected.is_none() {
-            detected = Some((run.tick - start, out.implied_tension_n));
+            detected = Some((run.tick - start, run.drive.implied_tension_n()));
         }
     }
     let (after, implied_n) = detected.expect("the mismatch is found");
@@ -821,7 +821,7 @@ fn a_load_cell_reading_ten_times_the_tension_is_dropped_and_the_drum_follows() {
         "{}",
         run.drum.speed_mps()
     );
-    let implied = f64::from(run.drive.output().implied_tension_n);
+    let implied = f64::from(run.drive.implied_tension_n());
     assert!((implied - 20.0).abs() < 5.0, "{implied} N");
     // Trusted again once cleared.
     assert_eq!(run.drive.clear_trip(), None);

@@ -79,8 +79,7 @@ impl SpeedLoop {
                 // The ramp is from rest: the brake was not free at the command.
                 self.ramp.start_tick = tick;
                 let tether_nm = tension_n * self.cfg.geometry.drum_radius_m;
-                self.checks
-                    .start_observer(self.momentum_nms(speed_mps), tether_nm);
+                self.checks.start_observer(speed_mps, tether_nm);
                 Brake::Released { rest_ticks: 0 }
             }
             Brake::Releasing { ticks_left } => Brake::Releasing {

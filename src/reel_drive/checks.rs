@@ -5,24 +5,31 @@
 //! J ω̇ = τ + T r − b ω − c sat(ω) ([`DrumModel`](super::DrumModel)); the drive knows τ (its
 //! duty × τ_max, the driver in torque mode), ω (the encoder) and the model, so the tether's
 //! torque T r is what is left. A generalised momentum observer (De Luca and Mattone, 2003)
-//! estimates it without differentiating the speed: with p = J ω the drum's momentum,
+//! estimates it without differentiating the speed. Written on the drum's surface speed v = ω r
+//! (its momentum J ω = (J / r) v):
 //!
 //! ```text
-//! p̂ₖ = p̂ₖ₋₁ + Δt (τₖ₋₁ + D̂ₖ₋₁ − b ωₖ − c sat(ωₖ))      (the model's momentum)
-//! D̂ₖ = K (pₖ − p̂ₖ)                                      (the torque it misses: T r)
+//! v̂ₖ = v̂ₖ₋₁ + Δt (r / J) (τₖ₋₁ + D̂ₖ₋₁ − b ω − c sat(ω))    (the model's speed)
+//! D̂ₖ = K (J / r) (vₖ − v̂ₖ)                                 (the torque it misses: T r)
 //! ```
 //!
 //! so that D̂ follows the true tether torque as a first-order lag of bandwidth K
 //! ([`FaultLimits::observer_bandwidth_radps`](super::FaultLimits::observer_bandwidth_radps)),
-//! plus the model's own error (friction, inertia). T̂ = D̂ / r is the implied tension. It
-//! restarts at each release of the brake from the load cell's tension (no transient), and is
-//! judged only while the drum is driven (released, not at rest, with a measured speed):
+//! plus the model's own error (friction, inertia). The friction is the feed-forward's, at the
+//! reference the drum follows (the speed loop keeps the two close; where they part, as in a
+//! runaway, the friction is the smaller term by far). T̂ = D̂ / r is the implied tension. It
+//! restarts at each release of the brake from the tension the feed-forward uses (no
+//! transient), and is judged only while the drum is driven (released, not at rest, with a
+//! measured speed), against that tension T_ff:
 //!
+//! - |T̂ − T_ff| within `tension_mismatch_n`: they agree (and T̂, within the tolerance of a
+//!   tension inside [min, max], is a plausible one);
 //! - T̂ beyond the plausible range [min, max] by more than `tension_mismatch_n`: no tether can
 //!   explain how the drum moves under the motor (a frozen encoder with the drum running away,
 //!   a seized drum): [`DriveFault::NoResponse`], tripped;
-//! - T̂ inside it but `tension_mismatch_n` away from the load cell's reading: the load cell is
-//!   wrong, [`DriveFault::TensionMismatch`], and the drive stops using it.
+//! - T̂ inside it but `tension_mismatch_n` away from the load cell's: the load cell is wrong,
+//!   [`DriveFault::TensionMismatch`], and the drive stops using it (T_ff = 0 from then on:
+//!   only the first test is left).
 //!
 //! Each must last `no_response_ticks`. The third check needs no model: an integral pinned at
 //! its clamp (± τ_max) for `no_response_ticks` is a drive whose drum does not answer the
@@ -37,8 +44,8 @@ use super::DriveFault;
 /// The state of the cross-checks.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct CrossChecks {
-    /// The drum's momentum the model predicts, p̂, N m s.
-    predicted_momentum_nms: f32,
+    /// The drum's surface speed the model predicts, v̂, m/s.
+    predicted_speed_mps: f32,
     /// The tether's torque at the drum the observer finds, D̂ = T̂ r, N m.
     pub(super) implied_tether_nm: f32,
     /// Consecutive judged ticks with T̂ beyond any tether.
@@ -55,15 +62,15 @@ pub(super) struct CrossChecks {
     pub(super) held_at_count: Option<u32>,
 }
 
-/// The limits of the implied-tension checks, N at the drum's surface.
+/// The limits of the implied-tension checks, as tether torques at the drum (tension × r).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct TensionJudge {
-    /// Below this T̂ no tether can explain the motion, N.
-    pub(super) lowest_n: f32,
-    /// Above this neither, N.
-    pub(super) highest_n: f32,
-    /// The largest |T̂ − reading| that is agreement, N.
-    pub(super) mismatch_n: f32,
+    /// Below this D̂ no tether can explain the motion, N m.
+    pub(super) lowest_nm: f32,
+    /// Above this neither, N m.
+    pub(super) highest_nm: f32,
+    /// The largest |D̂ − T_ff r| that is agreement, N m.
+    pub(super) mismatch_nm: f32,
     /// Ticks a disagreement must last.
     pub(super) ticks: u32,
 }
@@ -71,7 +78,7 @@ pub(super) struct TensionJudge {
 impl CrossChecks {
     /// Nothing judged yet, the load cell trusted.
     pub(super) const START: Self = Self {
-        predicted_momentum_nms: 0.0,
+        predicted_speed_mps: 0.0,
         implied_tether_nm: 0.0,
         implausible_ticks: 0,
         mismatch_ticks: 0,
@@ -80,56 +87,57 @@ impl CrossChecks {
         held_at_count: None,
     };
 
-    /// Restarts the observer at a release: the drum's momentum as measured, the tether's torque
+    /// Restarts the observer at a release: the drum's speed as measured, the tether's torque
     /// as the feed-forward takes it.
-    pub(super) fn start_observer(&mut self, momentum_nms: f32, tether_nm: f32) {
-        self.predicted_momentum_nms = momentum_nms;
+    pub(super) fn start_observer(&mut self, speed_mps: f32, tether_nm: f32) {
+        self.predicted_speed_mps = speed_mps;
         self.implied_tether_nm = tether_nm;
         self.implausible_ticks = 0;
         self.mismatch_ticks = 0;
     }
 
-    /// One observer step over `dt_s`, the motor having applied `applied_nm` since the last one,
-    /// the drum now at `momentum_nms` with the model's friction `friction_nm`.
+    /// One observer step: the drum now at `speed_mps`, the motor's torque less the model's
+    /// friction `net_nm` since the last step, `speed_per_impulse` = Δt r / J (m/s per N m over
+    /// the step) and `gain_nm_per_mps` = K J / r.
     pub(super) fn observe(
         &mut self,
-        momentum_nms: f32,
-        applied_nm: f32,
-        friction_nm: f32,
-        dt_s: f32,
-        gain_per_s: f32,
+        speed_mps: f32,
+        net_nm: f32,
+        speed_per_impulse: f32,
+        gain_nm_per_mps: f32,
     ) {
-        self.predicted_momentum_nms += dt_s * (applied_nm + self.implied_tether_nm - friction_nm);
-        self.implied_tether_nm = gain_per_s * (momentum_nms - self.predicted_momentum_nms);
+        self.predicted_speed_mps += speed_per_impulse * (net_nm + self.implied_tether_nm);
+        self.implied_tether_nm = gain_nm_per_mps * (speed_mps - self.predicted_speed_mps);
     }
 
-    /// Judges the implied tension `implied_n` against the plausible range and against the load
-    /// cell's `reading_n` (`None`: no usable reading this tick), over `gap_ticks`: the fault a
-    /// lasting disagreement is.
+    /// Judges the implied tether torque against `used_nm`, the torque of the tension the
+    /// feed-forward uses (T_ff r), over `gap_ticks`: the fault a lasting disagreement is.
     pub(super) fn judge_tension(
         &mut self,
-        implied_n: f32,
-        reading_n: Option<f32>,
+        used_nm: f32,
         gap_ticks: u32,
         j: &TensionJudge,
     ) -> Option<DriveFault> {
-        if implied_n < j.lowest_n || implied_n > j.highest_n {
+        let implied_nm = self.implied_tether_nm;
+        if self.load_cell_trusted && (implied_nm - used_nm).abs() <= j.mismatch_nm {
+            self.implausible_ticks = 0;
+            self.mismatch_ticks = 0;
+            return None;
+        }
+        if implied_nm < j.lowest_nm || implied_nm > j.highest_nm {
             self.implausible_ticks = self.implausible_ticks.saturating_add(gap_ticks);
             if self.implausible_ticks >= j.ticks {
                 return Some(DriveFault::NoResponse);
             }
-        } else {
-            self.implausible_ticks = 0;
+            return None;
         }
-        match reading_n {
-            Some(t) if self.load_cell_trusted && (implied_n - t).abs() > j.mismatch_n => {
-                self.mismatch_ticks = self.mismatch_ticks.saturating_add(gap_ticks);
-                if self.mismatch_ticks >= j.ticks {
-                    self.load_cell_trusted = false;
-                    return Some(DriveFault::TensionMismatch);
-                }
+        self.implausible_ticks = 0;
+        if self.load_cell_trusted {
+            self.mismatch_ticks = self.mismatch_ticks.saturating_add(gap_ticks);
+            if self.mismatch_ticks >= j.ticks {
+                self.load_cell_trusted = false;
+                return Some(DriveFault::TensionMismatch);
             }
-            _ => self.mismatch_ticks = 0,
         }
         None
     }
@@ -151,56 +159,56 @@ mod tests {
     /// a few of its time constants.
     #[test]
     fn the_observer_finds_the_torque_the_model_misses() {
-        let (j, dt, k) = (0.05_f32, 1e-3_f32, 20.0_f32);
+        let (j_per_r, dt, k) = (0.5_f32, 1e-3_f32, 20.0_f32);
         let mut c = CrossChecks::START;
         c.start_observer(0.0, 0.0);
-        let mut w = 0.0_f32;
+        let mut v = 0.0_f32;
         for _ in 0..250 {
-            w += dt * (-1.0 + 2.0) / j;
-            c.observe(j * w, -1.0, 0.0, dt, k);
+            v += dt * (-1.0 + 2.0) / j_per_r;
+            c.observe(v, -1.0, dt / j_per_r, k * j_per_r);
         }
         // 250 ms is 5 time constants: e^−5 = 0.7 % of the step left.
-        assert!(
-            (c.implied_tether_nm - 2.0).abs() < 0.02,
-            "{}",
-            c.implied_tether_nm
-        );
+        assert!((c.implied_tether_nm - 2.0).abs() < 0.02, "{}", c.implied_tether_nm);
     }
 
     #[test]
     fn a_lasting_disagreement_is_a_fault_a_passing_one_is_not() {
+        // (Torques of a 0.1 m drum: −2.5 … 22 N m is −25 … 220 N.)
         let j = TensionJudge {
-            lowest_n: -25.0,
-            highest_n: 220.0,
-            mismatch_n: 20.0,
+            lowest_nm: -2.5,
+            highest_nm: 22.0,
+            mismatch_nm: 2.0,
             ticks: 10,
+        };
+        let judge = |c: &mut CrossChecks, implied_nm: f32, used_nm: f32| {
+            c.implied_tether_nm = implied_nm;
+            c.judge_tension(used_nm, 1, &j)
         };
         let mut c = CrossChecks::START;
         for _ in 0..9 {
-            assert_eq!(c.judge_tension(-30.0, Some(20.0), 1, &j), None);
+            assert_eq!(judge(&mut c, -3.0, 2.0), None);
         }
-        // A tick back inside restarts the count.
-        assert_eq!(c.judge_tension(20.0, Some(20.0), 1, &j), None);
+        // A tick back in agreement restarts the count.
+        assert_eq!(judge(&mut c, 2.0, 2.0), None);
         for _ in 0..9 {
-            assert_eq!(c.judge_tension(-30.0, Some(-5.0), 1, &j), None);
+            assert_eq!(judge(&mut c, -3.0, -0.5), None);
         }
-        assert_eq!(
-            c.judge_tension(-30.0, Some(-5.0), 1, &j),
-            Some(DriveFault::NoResponse)
-        );
-        // Plausible but far from the reading: the load cell is dropped, once.
+        assert_eq!(judge(&mut c, -3.0, -0.5), Some(DriveFault::NoResponse));
+        // Plausible but far from the load cell's: the load cell is dropped, once.
         let mut c = CrossChecks::START;
         for _ in 0..9 {
-            assert_eq!(c.judge_tension(20.0, Some(199.0), 1, &j), None);
+            assert_eq!(judge(&mut c, 2.0, 19.9), None);
         }
-        assert_eq!(
-            c.judge_tension(20.0, Some(199.0), 1, &j),
-            Some(DriveFault::TensionMismatch)
-        );
+        assert_eq!(judge(&mut c, 2.0, 19.9), Some(DriveFault::TensionMismatch));
         assert!(!c.load_cell_trusted);
+        // Untrusted, only the plausibility is judged.
         for _ in 0..20 {
-            assert_eq!(c.judge_tension(20.0, Some(199.0), 1, &j), None);
+            assert_eq!(judge(&mut c, 2.0, 0.0), None);
         }
+        for _ in 0..9 {
+            assert_eq!(judge(&mut c, 23.0, 0.0), None);
+        }
+        assert_eq!(judge(&mut c, 23.0, 0.0), Some(DriveFault::NoResponse));
     }
 
     #[test]

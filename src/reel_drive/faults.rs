@@ -26,7 +26,7 @@ pub enum DriveFault {
     /// A pin or the PWM refused a write (reported by the driver, [`super::hal::HalReelDrive`]).
     Actuator,
     /// The drum does not move as the motor's torque and any tether could make it: the tension
-    /// its motion implies ([`super::CrossChecks`]) lies beyond the plausible range by more than
+    /// its motion implies (the cross-checks, `reel_drive/checks.rs`) lies beyond the plausible range by more than
     /// `tension_mismatch_n`, or the integral has been pinned at its clamp, for
     /// `no_response_ticks` (a frozen or slipping encoder, a seized drum): tripped.
     NoResponse,
@@ -85,9 +85,9 @@ impl DriveFault {
     /// | `EncoderJump`, `EncoderMissing` | [`OuterReaction::Degrade`] | the length sample comes from this encoder | HZ-1 / HZ-6 |
     /// | `DutySaturated` | [`OuterReaction::Degrade`] | the drum does not follow the command: coast on the last one, safe hold if it lasts | HZ-7 |
     /// | `TensionOutOfRange` | [`OuterReaction::Degrade`] | slack, break or overload: the law's model does not hold | HZ-10 |
-    /// | `MotorStall`, `Actuator`, `NoResponse` | [`OuterReaction::SafeHold`] | the drive tripped: the reel cannot move | HZ-7, HZ-16 |
-    /// | `BrakeSlip` | [`OuterReaction::SafeHold`] | the brake cannot hold: the motor holds the drum | HZ-17 |
-    /// | `TensionMismatch` | [`OuterReaction::Report`] | the drive no longer uses the load cell and still follows the command | HZ-18 |
+    /// | `MotorStall`, `Actuator`, `NoResponse` | [`OuterReaction::SafeHold`] | the drive tripped: the reel cannot move | HZ-7, HZ-R1 |
+    /// | `BrakeSlip` | [`OuterReaction::SafeHold`] | the brake cannot hold: the motor holds the drum | HZ-R2 |
+    /// | `TensionMismatch` | [`OuterReaction::Report`] | the drive no longer uses the load cell and still follows the command | HZ-R3 |
     /// | `Tick`, `CommandInvalid` | [`OuterReaction::Report`] | the caller's own error; the drive already holds | HZ-12 |
     pub fn outer_reaction(self) -> OuterReaction {
         match self {
