@@ -31,9 +31,10 @@
 //!   [`DriveFault::TensionMismatch`], and the drive stops using it (T_ff = 0 from then on:
 //!   only the first test is left).
 //!
-//! Each must last `no_response_ticks`. The third check needs no model: an integral pinned at
-//! its clamp (± τ_max) for `no_response_ticks` is a drive whose drum does not answer the
-//! torque (its error has not shrunk however long it integrated): [`DriveFault::NoResponse`].
+//! Each must last `no_response_ticks`. Once the load cell is dropped, an integral pinned at
+//! its clamp (± τ_max) is a drum that does not answer the torque as well (its error has not
+//! shrunk however long it integrated; with the load cell trusted, a wrong reading pins it
+//! too): [`DriveFault::NoResponse`].
 //!
 //! **Motion with the brake engaged.** The odometer counts the drum whatever the brake: a travel
 //! of more than `brake_slip_m` from where the engaged brake first held it is a slipping brake,
@@ -48,12 +49,11 @@ pub(super) struct CrossChecks {
     predicted_speed_mps: f32,
     /// The tether's torque at the drum the observer finds, D̂ = T̂ r, N m.
     pub(super) implied_tether_nm: f32,
-    /// Consecutive judged ticks with T̂ beyond any tether.
-    implausible_ticks: u32,
+    /// Consecutive judged ticks with the drum not answering the torque (T̂ beyond any tether,
+    /// or, the load cell dropped, the integral at its clamp).
+    unanswered_ticks: u32,
     /// Consecutive judged ticks with T̂ away from the load cell.
     mismatch_ticks: u32,
-    /// Consecutive driven ticks with the integral at its clamp.
-    pub(super) pinned_ticks: u32,
     /// Whether the feed-forward uses the load cell (false after
     /// [`DriveFault::TensionMismatch`], until `clear_trip`).
     pub(super) load_cell_trusted: bool,
@@ -80,9 +80,8 @@ impl CrossChecks {
     pub(super) const START: Self = Self {
         predicted_speed_mps: 0.0,
         implied_tether_nm: 0.0,
-        implausible_ticks: 0,
+        unanswered_ticks: 0,
         mismatch_ticks: 0,
-        pinned_ticks: 0,
         load_cell_trusted: true,
         held_at_count: None,
     };
@@ -92,7 +91,7 @@ impl CrossChecks {
     pub(super) fn start_observer(&mut self, speed_mps: f32, tether_nm: f32) {
         self.predicted_speed_mps = speed_mps;
         self.implied_tether_nm = tether_nm;
-        self.implausible_ticks = 0;
+        self.unanswered_ticks = 0;
         self.mismatch_ticks = 0;
     }
 
@@ -112,27 +111,33 @@ impl CrossChecks {
 
     /// Judges the implied tether torque against `used_nm`, the torque of the tension the
     /// feed-forward uses (T_ff r), over `gap_ticks`: the fault a lasting disagreement is.
+    /// `pinned` says whether the integral is at its clamp (judged only once the load cell is
+    /// dropped: a load cell that is wrong pins the integral too).
     pub(super) fn judge_tension(
         &mut self,
         used_nm: f32,
+        pinned: bool,
         gap_ticks: u32,
         j: &TensionJudge,
     ) -> Option<DriveFault> {
         let implied_nm = self.implied_tether_nm;
-        if self.load_cell_trusted && (implied_nm - used_nm).abs() <= j.mismatch_nm {
-            self.implausible_ticks = 0;
+        let trusted = self.load_cell_trusted;
+        if trusted && (implied_nm - used_nm).abs() <= j.mismatch_nm {
+            self.unanswered_ticks = 0;
             self.mismatch_ticks = 0;
             return None;
         }
-        if implied_nm < j.lowest_nm || implied_nm > j.highest_nm {
-            self.implausible_ticks = self.implausible_ticks.saturating_add(gap_ticks);
-            if self.implausible_ticks >= j.ticks {
+        let unanswered =
+            implied_nm < j.lowest_nm || implied_nm > j.highest_nm || (!trusted && pinned);
+        if unanswered {
+            self.unanswered_ticks = self.unanswered_ticks.saturating_add(gap_ticks);
+            if self.unanswered_ticks >= j.ticks {
                 return Some(DriveFault::NoResponse);
             }
             return None;
         }
-        self.implausible_ticks = 0;
-        if self.load_cell_trusted {
+        self.unanswered_ticks = 0;
+        if trusted {
             self.mismatch_ticks = self.mismatch_ticks.saturating_add(gap_ticks);
             if self.mismatch_ticks >= j.ticks {
                 self.load_cell_trusted = false;
@@ -168,7 +173,11 @@ mod tests {
             c.observe(v, -1.0, dt / j_per_r, k * j_per_r);
         }
         // 250 ms is 5 time constants: e^−5 = 0.7 % of the step left.
-        assert!((c.implied_tether_nm - 2.0).abs() < 0.02, "{}", c.implied_tether_nm);
+        assert!(
+            (c.implied_tether_nm - 2.0).abs() < 0.02,
+            "{}",
+            c.implied_tether_nm
+        );
     }
 
     #[test]
@@ -182,7 +191,7 @@ mod tests {
         };
         let judge = |c: &mut CrossChecks, implied_nm: f32, used_nm: f32| {
             c.implied_tether_nm = implied_nm;
-            c.judge_tension(used_nm, 1, &j)
+            c.judge_tension(used_nm, false, 1, &j)
         };
         let mut c = CrossChecks::START;
         for _ in 0..9 {
@@ -209,6 +218,22 @@ mod tests {
             assert_eq!(judge(&mut c, 23.0, 0.0), None);
         }
         assert_eq!(judge(&mut c, 23.0, 0.0), Some(DriveFault::NoResponse));
+        // Untrusted, a pinned integral is a drum that does not answer; trusted, it is not
+        // judged (a wrong load cell pins it too).
+        c.implied_tether_nm = 2.0;
+        assert_eq!(c.judge_tension(0.0, false, 1, &j), None);
+        for _ in 0..9 {
+            assert_eq!(c.judge_tension(0.0, true, 1, &j), None);
+        }
+        assert_eq!(
+            c.judge_tension(0.0, true, 1, &j),
+            Some(DriveFault::NoResponse)
+        );
+        let mut c = CrossChecks::START;
+        c.implied_tether_nm = 2.0;
+        for _ in 0..20 {
+            assert_eq!(c.judge_tension(2.0, true, 1, &j), None);
+        }
     }
 
     #[test]

@@ -500,8 +500,7 @@ impl SpeedLoop {
                     self.stall_ticks = 0;
                     drive
                 } else {
-                    match self.driven_checks(gap_ticks, speed_mps, &drive, tension_n, &mut faults)
-                    {
+                    match self.driven_checks(gap_ticks, speed_mps, &drive, tension_n, &mut faults) {
                         Some(fault) => self.trip_driven(fault, &mut faults),
                         None => drive,
                     }
@@ -517,12 +516,10 @@ impl SpeedLoop {
             }
             Brake::Releasing { .. } => {
                 self.stall_ticks = 0;
-                self.checks.pinned_ticks = 0;
                 self.driven(0.0, 0.0, self.tension_torque_nm(tension_n))
             }
             Brake::Engaged => {
                 self.stall_ticks = 0;
-                self.checks.pinned_ticks = 0;
                 self.integral_nm = 0.0;
                 if counted && self.brake_slipped() {
                     // The motor takes over from the next tick.
@@ -534,7 +531,6 @@ impl SpeedLoop {
             Brake::Tripped(f) => {
                 faults.insert(f);
                 self.stall_ticks = 0;
-                self.checks.pinned_ticks = 0;
                 self.integral_nm = 0.0;
                 // The motor off, the brake is all that holds the drum: its slip is reported.
                 if counted && self.brake_slipped() {
@@ -654,27 +650,23 @@ impl SpeedLoop {
             return Some(DriveFault::MotorStall);
         }
         let used_nm = tension_n * self.cfg.geometry.drum_radius_m;
+        let pinned = self.integral_nm.abs() >= self.cfg.max_torque_nm;
         match self
             .checks
-            .judge_tension(used_nm, gap_ticks, &self.derived.judge)
+            .judge_tension(used_nm, pinned, gap_ticks, &self.derived.judge)
         {
-            Some(DriveFault::TensionMismatch) => faults.insert(DriveFault::TensionMismatch),
-            Some(fault) => return Some(fault),
-            None => {}
+            Some(DriveFault::TensionMismatch) => {
+                faults.insert(DriveFault::TensionMismatch);
+                None
+            }
+            fault => fault,
         }
-        // The integral pinned at its clamp (counted by `speed_law`).
-        if self.checks.pinned_ticks >= self.cfg.faults.no_response_ticks {
-            return Some(DriveFault::NoResponse);
-        }
-        None
     }
 
     /// The drive of a torque: the reference, the torque and its duty.
     fn driven(&self, ref_mps: f32, ref_accel_mps2: f32, torque_nm: f32) -> Drive {
-        let (duty, saturated) = saturate(
-            torque_nm * self.derived.per_max_torque,
-            self.cfg.duty_limit,
-        );
+        let (duty, saturated) =
+            saturate(torque_nm * self.derived.per_max_torque, self.cfg.duty_limit);
         Drive {
             ref_mps,
             ref_accel_mps2,
@@ -686,8 +678,7 @@ impl SpeedLoop {
 
     /// PI + feed-forward toward the reference `ref_mps`, `ref_accel_mps2` (see the module
     /// docs), with conditional integration: the integral does not grow in the direction that
-    /// held the last tick's duty in saturation. Counts the ticks the integral is pinned at its
-    /// clamp, and steps the observer of the implied tension (`reel_drive/checks.rs`: the motor
+    /// held the last tick's duty in saturation. Steps the observer of the implied tension (`reel_drive/checks.rs`: the motor
     /// applied the last step's duty since; the model's friction is the feed-forward's).
     /// Returns the torque, N m.
     fn speed_law(
@@ -703,16 +694,11 @@ impl SpeedLoop {
         let error_mps = ref_mps - speed_mps;
         let winding_up = self.saturated && self.duty * error_mps > 0.0;
         if !winding_up {
-            let (integral_nm, pinned) = saturate(
+            self.integral_nm = saturate(
                 self.integral_nm + d.ki_tick * gap * error_mps,
                 self.cfg.max_torque_nm,
-            );
-            self.integral_nm = integral_nm;
-            self.checks.pinned_ticks = if pinned {
-                self.checks.pinned_ticks.saturating_add(gap_ticks)
-            } else {
-                0
-            };
+            )
+            .0;
         }
         let friction_nm = self.friction_torque_nm(ref_mps);
         self.checks.observe(
