@@ -700,9 +700,8 @@ fn the_length_is_the_integer_count_to_within_a_count() {
 fn a_frozen_encoder_trips_the_drive_before_the_drum_runs_away() {
     for frozen_mps in [0.01, 0.02, 0.05] {
         // (Winding in at 0.5 m/s, the drum's motion implies a tension a tether could pull but
-        // the load cell does not read: the load cell is dropped after 0.1 s; the duty, at its
-        // limit, keeps the integral off its clamp, and the stall check trips the drive at
-        // 0.5 s, the frozen speed being below the stall speed.)
+        // the load cell does not read: the load cell is dropped after 0.1 s, then the loop,
+        // pinned at its limit, trips the drive.)
         for command_mps in [0.1_f32, 0.5, 1.0, -0.5] {
             let mut run = settled_at(DriveConfig::example(), command_mps);
             let start_m = run.drum.paid_out_m();

@@ -31,10 +31,10 @@
 //!   [`DriveFault::TensionMismatch`], and the drive stops using it (T_ff = 0 from then on:
 //!   only the first test is left).
 //!
-//! Each must last `no_response_ticks`. Once the load cell is dropped, an integral pinned at
-//! its clamp (± τ_max) is a drum that does not answer the torque as well (its error has not
-//! shrunk however long it integrated; with the load cell trusted, a wrong reading pins it
-//! too): [`DriveFault::NoResponse`].
+//! Each must last `no_response_ticks`. Once the load cell is dropped, a loop pinned at its
+//! limit (the duty saturated, or the integral at its clamp ± τ_max) is a drum that does not
+//! answer the torque as well (with the load cell trusted, a wrong reading pins it too):
+//! [`DriveFault::NoResponse`].
 //!
 //! **Motion with the brake engaged.** The odometer counts the drum whatever the brake: a travel
 //! of more than `brake_slip_m` from where the engaged brake first held it is a slipping brake,
@@ -111,8 +111,9 @@ impl CrossChecks {
 
     /// Judges the implied tether torque against `used_nm`, the torque of the tension the
     /// feed-forward uses (T_ff r), over `gap_ticks`: the fault a lasting disagreement is.
-    /// `pinned` says whether the integral is at its clamp (judged only once the load cell is
-    /// dropped: a load cell that is wrong pins the integral too).
+    /// `pinned` says whether the loop is at its limit, the duty saturated or the integral at
+    /// its clamp (judged only once the load cell is dropped: a load cell that is wrong pins the
+    /// loop too).
     pub(super) fn judge_tension(
         &mut self,
         used_nm: f32,

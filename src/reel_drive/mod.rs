@@ -650,10 +650,11 @@ impl SpeedLoop {
             return Some(DriveFault::MotorStall);
         }
         let used_nm = tension_n * self.cfg.geometry.drum_radius_m;
-        let pinned = self.integral_nm.abs() >= self.cfg.max_torque_nm;
+        // The loop at its limit: the duty saturated, or the integral at its clamp.
+        let at_limit = drive.saturated || self.integral_nm.abs() >= self.cfg.max_torque_nm;
         match self
             .checks
-            .judge_tension(used_nm, pinned, gap_ticks, &self.derived.judge)
+            .judge_tension(used_nm, at_limit, gap_ticks, &self.derived.judge)
         {
             Some(DriveFault::TensionMismatch) => {
                 faults.insert(DriveFault::TensionMismatch);
