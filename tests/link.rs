@@ -7,7 +7,8 @@
 use proptest::prelude::*;
 use tss_reel::link::{
     decode, encode, Command, End, Frame, FrameReader, Gate, Hello, LinkCounters, LinkError,
-    Message, Report, Sample, SampleGate, DELIMITER, MAX_WIRE_LEN, SAMPLE_MISSING, SAMPLE_VALID,
+    LoadVerdict, Loaded, Message, ParamTable, Report, Sample, SampleGate, DELIMITER, MAX_WIRE_LEN,
+    PARAM_WORDS, SAMPLE_MISSING, SAMPLE_VALID,
 };
 
 /// Cases per property: the issue asks for at least 100 000 on the decoder. `TSS_LINK_CASES`
@@ -98,6 +99,25 @@ fn message() -> impl Strategy<Value = Message> {
             timeout_periods: t,
         })),
         any::<u32>().prop_map(|ticks| Message::End(End { ticks })),
+        proptest::collection::vec(any::<u32>(), PARAM_WORDS).prop_map(|v| {
+            let mut words = [0u32; PARAM_WORDS];
+            words.copy_from_slice(&v);
+            Message::Params(ParamTable { words })
+        }),
+        (
+            any::<u32>(),
+            0..=LoadVerdict::Refused as u8,
+            any::<u8>(),
+            any::<u8>()
+        )
+            .prop_map(
+                |(config_digest, verdict, param, rule)| Message::Loaded(Loaded {
+                    config_digest,
+                    verdict,
+                    param,
+                    rule,
+                })
+            ),
         (
             proptest::array::uniform13(any::<u32>()),
             any::<u32>(),

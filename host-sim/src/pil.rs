@@ -3,8 +3,13 @@
 //!
 //! [`PilLink`] starts QEMU with the firmware ELF (`-append pil` selects the firmware's PIL
 //! mission), serial port 0 connected to a loopback TCP socket that `tss-sim` listens on, and the
-//! semihosting output (the defmt log) piped through `defmt-print -e ELF` into `firmware.log`. It
-//! implements [`Stepper`]: each control period the plant's sample goes out as one `Sample`
+//! semihosting output (the defmt log) piped through `defmt-print -e ELF` into `firmware.log`.
+//! After the firmware's hello it loads the scenario's controller configuration into the
+//! firmware as a parameter table ([`link::ParamTable`]): the firmware builds its controller from
+//! it, so the core on the MCU validates it, and answers with the digest of what it flies (the
+//! scenario's, or the run stops) or why it refused it. Any configuration the core accepts flies
+//! in the loop: the paper's, the flight one on the estimator (`Config::flight`), with a tether
+//! of any density, on the rigid or the elastic plant. It implements [`Stepper`]: each control period the plant's sample goes out as one `Sample`
 //! frame and the firmware's `Command` frame comes back with the whole controller output, so
 //! [`crate::sim::run_stepper`] writes the same history, figures and summaries as a host-linked
 //! run. Frames are those of [`tss_reel::link`].
@@ -36,10 +41,11 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command as Process, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
-use tss_reel::controller::{Input, Output};
+use tss_reel::controller::{Config, Controller, Input, Output};
 use tss_reel::link::{
-    self, Command, End, Frame, FrameReader, LinkCounters, LinkError, Message, Report, Sample,
-    SampleStatus, MAX_WIRE_LEN, SAMPLE_MISSING, SAMPLE_VALID,
+    self, Command, End, Frame, FrameReader, LinkCounters, LinkError, LoadVerdict, Loaded, Message,
+    ParamTable, Report, Sample, SampleStatus, MAX_WIRE_LEN, NO_PARAM, PARAMS, SAMPLE_MISSING,
+    SAMPLE_VALID,
 };
 
 use crate::faults::Pcg32;
@@ -87,12 +93,11 @@ pub enum PilError {
         #[source]
         source: std::io::Error,
     },
-    /// The firmware flies another controller configuration than the scenario describes.
+    /// The firmware flies another controller configuration than the one loaded into it.
     #[error(
-        "the firmware flies controller configuration {firmware:#010x}, the scenario describes \
-         {scenario:#010x}: PIL flies the firmware's built-in configuration (Config::paper()), so \
-         the scenario's [orbit], [masses], [controller], [stage1], [stage2], [envelope] and \
-         [monitor] must be the paper's (or the ELF is stale: rebuild it with `cargo fw-build`)"
+        "the firmware accepted the parameter table but flies controller configuration \
+         {firmware:#010x}, the scenario describes {scenario:#010x} (is the ELF stale? rebuild it \
+         with `cargo fw-build`)"
     )]
     ConfigMismatch {
         /// Digest the firmware sent.
@@ -100,6 +105,10 @@ pub enum PilError {
         /// Digest of the scenario's configuration.
         scenario: u32,
     },
+    /// The core refuses the controller configuration (the scenario's, checked here before the
+    /// firmware starts, or the table loaded into the firmware, refused there).
+    #[error("{0}")]
+    Refused(String),
     /// The scenario has more control periods than one PIL run may ([`link::MAX_TICKS`]).
     #[error(
         "simulation.duration_s = {duration_s} s is {ticks} control periods: a PIL run has at \
@@ -172,6 +181,10 @@ pub struct PilReport {
     pub spurious_timeouts: u32,
     /// The firmware's `Report` (its receive counters, commands sent and their digest).
     pub firmware_report: Report,
+    /// Digest of the firmware's built-in configuration (its hello).
+    pub builtin_digest: u32,
+    /// Digest of the configuration loaded into it and flown.
+    pub config_digest: u32,
     /// FNV-1a over the rate commands received here (equals the firmware's digest).
     pub digest: u32,
     /// Wall time of the exchange (QEMU start to exit).
@@ -222,6 +235,11 @@ impl PilReport {
             "Processor-in-the-loop: {} in QEMU mps2-an386, link v{} over UART0",
             self.firmware.display(),
             link::VERSION
+        );
+        let _ = writeln!(
+            o,
+            "  controller configuration loaded as a parameter table: digest {:#010x} (built-in {:#010x})",
+            self.config_digest, self.builtin_digest
         );
         let _ = writeln!(
             o,
@@ -333,14 +351,12 @@ fn spawn_error(tool: &'static str) -> impl FnOnce(std::io::Error) -> PilError {
 }
 
 impl PilLink {
-    /// Boots `firmware` in QEMU in PIL mode, its log going to `log`, and waits for its hello.
-    /// Fails if the firmware flies another configuration than `sc` describes.
+    /// Boots `firmware` in QEMU in PIL mode, its log going to `log`, waits for its hello and
+    /// loads `sc`'s controller configuration into it ([`Self::load`]). Fails if the core
+    /// refuses the configuration, here or on the MCU, or the firmware flies another one.
     pub fn start(sc: &Scenario, firmware: &Path, log: &Path) -> Result<Self, PilError> {
-        if !firmware.is_file() {
-            return Err(PilError::MissingFirmware(firmware.to_path_buf()));
-        }
-        let expected_digest = match sim::controller_config::<f32>(sc) {
-            Ok(cfg) => link::config_digest(&cfg),
+        let cfg = match sim::controller_config::<f32>(sc) {
+            Ok(cfg) => cfg,
             Err(e) => {
                 return Err(PilError::Firmware(
                     format!("the scenario's controller configuration is invalid: {e}"),
@@ -348,6 +364,24 @@ impl PilLink {
                 ))
             }
         };
+        // The same core judges it on the MCU; refusing it here names the parameter at once.
+        if let Err(e) = Controller::new(cfg) {
+            return Err(PilError::Refused(format!(
+                "the core refuses the scenario's controller configuration: {e}"
+            )));
+        }
+        let mut link = Self::boot(sc, firmware, log)?;
+        link.load(&cfg)?;
+        Ok(link)
+    }
+
+    /// Boots `firmware` in QEMU in PIL mode, its log going to `log`, and waits for its hello;
+    /// the firmware then waits for its parameter table ([`Self::load`], [`Self::load_table`]).
+    /// `sc` gives the link's fault injection.
+    pub fn boot(sc: &Scenario, firmware: &Path, log: &Path) -> Result<Self, PilError> {
+        if !firmware.is_file() {
+            return Err(PilError::MissingFirmware(firmware.to_path_buf()));
+        }
         let listener = TcpListener::bind("127.0.0.1:0").map_err(io("binding a loopback port"))?;
         let port = listener
             .local_addr()
@@ -442,20 +476,61 @@ impl PilLink {
             Message::Hello(h) => Some(*h),
             _ => None,
         })?;
-        if hello.config_digest != expected_digest {
+        link.report.builtin_digest = hello.config_digest;
+        Ok(link)
+    }
+
+    /// Loads `cfg` into the firmware as a parameter table; `Ok` once the firmware flies it
+    /// (the digest it answers is `cfg`'s).
+    pub fn load(&mut self, cfg: &Config<f32>) -> Result<(), PilError> {
+        let loaded = self.load_table(&ParamTable::from_config(cfg))?;
+        let expected = link::config_digest(cfg);
+        if loaded.config_digest != expected {
             return Err(PilError::ConfigMismatch {
-                firmware: hello.config_digest,
-                scenario: expected_digest,
+                firmware: loaded.config_digest,
+                scenario: expected,
             });
         }
-        let period_ms = (sc.controller.period_s * 1000.0).round();
-        if f64::from(hello.period_ms) != period_ms {
-            return Err(link.fail(format!(
-                "the firmware's control period is {} ms, the scenario's {period_ms} ms",
-                hello.period_ms
-            )));
+        self.report.config_digest = expected;
+        Ok(())
+    }
+
+    /// Sends `table` and returns the firmware's `Loaded` answer if it accepted it; a refusal
+    /// is [`PilError::Refused`], naming the word at fault and the core's rule (the firmware
+    /// then still waits for a table).
+    pub fn load_table(&mut self, table: &ParamTable) -> Result<Loaded, PilError> {
+        let mut wire = [0u8; MAX_WIRE_LEN];
+        let n = link::encode(self.seq, &Message::Params(*table), &mut wire)
+            .map_err(|e| self.fail(format!("encoding the parameter table: {e:?}")))?;
+        self.seq = self.seq.wrapping_add(1);
+        self.stream
+            .write_all(&wire[..n])
+            .map_err(io("writing to the firmware's UART"))?;
+        let loaded = self.receive(REPLY_TIMEOUT, "load verdict", |m| match m {
+            Message::Loaded(l) => Some(*l),
+            _ => None,
+        })?;
+        let name = PARAMS
+            .get(usize::from(loaded.param))
+            .filter(|_| loaded.param != NO_PARAM)
+            .map_or("(a group of parameters)", |(name, _)| name);
+        match LoadVerdict::from_code(loaded.verdict) {
+            Some(LoadVerdict::Accepted) => Ok(loaded),
+            Some(LoadVerdict::BadTable) => Err(PilError::Refused(format!(
+                "the firmware refused the parameter table: word {} ({name}) is not the shape of \
+                 a configuration",
+                loaded.param
+            ))),
+            Some(LoadVerdict::Refused) | None => {
+                let rule = link::rule_from_code(loaded.rule).map_or_else(
+                    || format!("rule code {}", loaded.rule),
+                    |r| format!("{r:?}"),
+                );
+                Err(PilError::Refused(format!(
+                    "the firmware's core refused the parameter table: {name} breaks rule {rule}"
+                )))
+            }
         }
-        Ok(link)
     }
 
     fn fail(&self, message: String) -> PilError {

@@ -1,9 +1,18 @@
 //! Processor-in-the-loop tests: the flight firmware ELF in QEMU flies the `tss-sim` plant over
 //! the emulated UART (`tss_sim::pil`).
 //!
-//! - `pil_flies_the_same_commands_as_the_host_linked_core`: the first 30 simulated minutes of
-//!   `scenarios/paper.toml`, every tick compared with the host-linked run: commands, lengths and
+//! - `pil_flies_the_flight_configuration_as_the_host_linked_core`: the first 30 simulated
+//!   minutes of `scenarios/paper.toml` with the sensors that fly (α, the encoder, the load cell;
+//!   no α̇), so the configuration loaded into the firmware is `Config::flight()` (the law on the
+//!   onboard estimator), every tick compared with the host-linked run: commands, lengths and
 //!   every other output bit for bit (the same f32 code on both sides).
+//! - `pil_flies_the_flight_configuration_on_the_elastic_plant`: the same on the elastic truth
+//!   model (`scenarios/paper-elastic.toml`: a tether of 0.19 g/m, whose density the loaded
+//!   configuration carries), over its first 20 minutes.
+//! - `a_refused_parameter_table_names_its_parameter_and_changes_nothing`: tables the core
+//!   refuses (a negative gain) or that are not the shape of a configuration are refused on the
+//!   MCU with the parameter named; the firmware then flies the good table it is sent next, as
+//!   the host-linked core does.
 //! - `link_faults_are_dropouts_counted_on_both_sides`: the same stretch with every kind of link
 //!   fault injected; both ends count the same faults, the tether stays inside its envelope, and
 //!   a host-linked run with sensor dropouts at exactly the ticks the firmware had no sample
@@ -21,9 +30,11 @@
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use tss_reel::controller::{Controller, Input, Output};
+use tss_reel::config::RateSource;
+use tss_reel::controller::{Config, Controller, Input, Output};
+use tss_reel::link::{self, ParamTable, PARAMS};
 use tss_sim::history::History;
-use tss_sim::pil::{self, Injected, PilReport};
+use tss_sim::pil::{self, Injected, PilError, PilLink, PilReport};
 use tss_sim::scenario::Scenario;
 use tss_sim::sim::{self, SimError, Stepper};
 
@@ -75,18 +86,37 @@ fn firmware() -> Option<PathBuf> {
 }
 
 fn scenario(overrides: &[&str]) -> Scenario {
+    scenario_from("paper.toml", overrides)
+}
+
+/// `scenarios/FILE` over the first [`DURATION_S`], a history sample every period, then the
+/// overrides.
+fn scenario_from(file: &str, overrides: &[&str]) -> Scenario {
     let mut sets = vec![
         DURATION_S.to_string(),
         "simulation.output_interval_s=1".to_string(),
     ];
     sets.extend(overrides.iter().map(|s| s.to_string()));
-    Scenario::load(root().join("scenarios/paper.toml"), &sets).unwrap()
+    Scenario::load(root().join("scenarios").join(file), &sets).unwrap()
+}
+
+/// The sensors that fly: no α̇ sensor (the law flies the onboard estimator on α), a swing
+/// sensor of σ_α = 1e-4 rad (what `Config::flight()`'s estimator is tuned for), the encoder and
+/// the load cell (on by default).
+const FLIGHT_SENSORS: [&str; 2] = [
+    "sensors.alpha_rate.enabled=false",
+    "sensors.alpha.noise_std=1e-4",
+];
+
+/// The firmware's log file for the test `name`.
+fn log_path(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("tss-pil-test-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join("firmware.log")
 }
 
 fn run_pil(sc: &Scenario, elf: &Path, name: &str) -> (History, PilReport) {
-    let dir = std::env::temp_dir().join(format!("tss-pil-test-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let log = dir.join("firmware.log");
+    let log = log_path(name);
     match pil::run(sc, elf, &log, &[], &mut |_| {}) {
         Ok(r) => r,
         Err(e) => {
@@ -119,22 +149,18 @@ fn assert_identical(a: &History, b: &History) {
     assert_eq!(a.faults, b.faults, "fault summaries differ");
 }
 
-#[test]
-fn pil_flies_the_same_commands_as_the_host_linked_core() {
-    let Some(elf) = firmware() else { return };
-    let _one = QEMU.lock().unwrap_or_else(|e| e.into_inner());
-    let sc = scenario(&[]);
-    let host = sim::run(&sc, &[], &mut |_| {}).unwrap();
-    let (pil, report) = run_pil(&sc, &elf, "agreement");
+/// Flies `sc` on the host and in PIL and checks both bit for bit; returns the PIL report.
+fn assert_pil_is_the_host(sc: &Scenario, elf: &Path, name: &str) -> PilReport {
+    let host = sim::run(sc, &[], &mut |_| {}).unwrap();
+    let (pil, report) = run_pil(sc, elf, name);
     eprint!("{}", report.render());
     assert_eq!(
         report.spurious_timeouts, 0,
         "the host stalled past the firmware's timeout"
     );
     assert!(report.consistent());
-    assert_eq!(report.ticks, 1801);
-    assert_eq!(report.status.fresh, 1801);
-
+    assert_eq!(report.ticks, pil.faults.ticks);
+    assert_eq!(report.status.fresh, report.ticks);
     let d_cmd = max_diff(&host, &pil, |s| s.length_rate_mps);
     let d_len = max_diff(&host, &pil, |s| s.length_m);
     eprintln!(
@@ -142,6 +168,86 @@ fn pil_flies_the_same_commands_as_the_host_linked_core() {
         pil.samples.len()
     );
     assert_identical(&host, &pil);
+    report
+}
+
+#[test]
+fn pil_flies_the_flight_configuration_as_the_host_linked_core() {
+    let Some(elf) = firmware() else { return };
+    let _one = QEMU.lock().unwrap_or_else(|e| e.into_inner());
+    let sc = scenario(&FLIGHT_SENSORS);
+    let report = assert_pil_is_the_host(&sc, &elf, "agreement");
+    assert_eq!(report.ticks, 1801);
+    // What was loaded and flown is the flight configuration, the firmware's built-in one.
+    assert_eq!(
+        sim::controller_config::<f32>(&sc).unwrap(),
+        Config::flight()
+    );
+    let flight = link::config_digest(&Config::flight());
+    assert_eq!(report.config_digest, flight);
+    assert_eq!(report.builtin_digest, flight);
+}
+
+#[test]
+fn pil_flies_the_flight_configuration_on_the_elastic_plant() {
+    let Some(elf) = firmware() else { return };
+    let _one = QEMU.lock().unwrap_or_else(|e| e.into_inner());
+    let sc = scenario_from(
+        "paper-elastic.toml",
+        &[&FLIGHT_SENSORS[..], &["simulation.duration_s=1200"]].concat(),
+    );
+    let cfg = sim::controller_config::<f32>(&sc).unwrap();
+    assert!(matches!(cfg.rate_source, RateSource::Estimator(_)));
+    assert!(cfg.masses.tether_density_kg_per_m > 0.0);
+    let report = assert_pil_is_the_host(&sc, &elf, "elastic");
+    assert_eq!(report.config_digest, link::config_digest(&cfg));
+    assert_ne!(report.config_digest, report.builtin_digest);
+}
+
+#[test]
+fn a_refused_parameter_table_names_its_parameter_and_changes_nothing() {
+    let Some(elf) = firmware() else { return };
+    let _one = QEMU.lock().unwrap_or_else(|e| e.into_inner());
+    let sc = scenario(&[&FLIGHT_SENSORS[..], &["simulation.duration_s=20"]].concat());
+    let cfg = sim::controller_config::<f32>(&sc).unwrap();
+    let log = log_path("refused");
+    let mut link = PilLink::boot(&sc, &elf, &log).unwrap();
+
+    let mut bad = cfg;
+    bad.gains.k1_per_s = -1.0;
+    match link.load_table(&ParamTable::from_config(&bad)) {
+        Err(PilError::Refused(m)) => {
+            eprintln!("{m}");
+            assert!(
+                m.contains("gains.k1_per_s") && m.contains("NotPositive"),
+                "{m}"
+            );
+        }
+        other => panic!("a negative gain was not refused: {other:?}"),
+    }
+    let tag = PARAMS
+        .iter()
+        .position(|(n, _)| *n == "protection?")
+        .unwrap();
+    let mut shapeless = ParamTable::from_config(&cfg);
+    shapeless.words[tag] = 7;
+    match link.load_table(&shapeless) {
+        Err(PilError::Refused(m)) => {
+            eprintln!("{m}");
+            assert!(m.contains("protection?"), "{m}");
+        }
+        other => panic!("a tag of 7 was not refused: {other:?}"),
+    }
+
+    // Nothing of the refused tables remains: the good one flies as on the host.
+    link.load(&cfg).unwrap();
+    let pil = sim::run_stepper::<f32, _>(&sc, &mut link, &[], &mut |_| {}).unwrap();
+    let report = link.finish(pil.faults.ticks).unwrap();
+    assert!(report.consistent());
+    let host = sim::run(&sc, &[], &mut |_| {}).unwrap();
+    assert_identical(&host, &pil);
+    let text = std::fs::read_to_string(&log).unwrap();
+    assert_eq!(text.matches("parameter table refused").count(), 2, "{text}");
 }
 
 /// The host-linked core, with a dropout forced at the given ticks (those the firmware had no

@@ -1,8 +1,13 @@
 //! Processor-in-the-loop (PIL): the flight controller closes the loop with the `tss-sim` plant
 //! over UART0, one frame pair per control period (`tss-sim run --pil`, `host-sim/src/pil.rs`).
 //!
-//! The firmware announces itself with a `Hello` frame (protocol version, the digest of the
-//! controller configuration it flies, its period and sample timeout), then, for every control
+//! The firmware announces itself with a `Hello` frame (protocol version, the digest of its
+//! built-in configuration `Config::flight()`, its period and sample timeout), then waits for the
+//! plant's `Params` frame: the controller configuration to fly, as the parameter table
+//! ([`tss_reel::link::ParamTable`]). It builds the controller from it, so the core's own
+//! validation ([`Config::validate`]) judges the table, and answers with `Loaded`: the digest of
+//! the configuration it now flies, or why it refused it (the word at fault and the core's rule;
+//! a refused table changes nothing, and the firmware waits for another). Then, for every control
 //! period: waits for the plant's `Sample` frame, steps the controller on it (the frame carries
 //! the controller's whole `Input`, the optional readings included: α̇ for a controller that
 //! flies on a rate sensor, the reel's rate, the tension), and sends the `Command` frame (the
@@ -32,8 +37,8 @@ use embedded_io::Write as _;
 use tss_reel::controller::{Config, Controller, Input, Output};
 use tss_reel::hal::{ErrorKind, ErrorType, ReelDrive};
 use tss_reel::link::{
-    self, Command, FrameReader, Gate, Hello, LinkCounters, LinkError, Message, Report, Sample,
-    SampleGate, SampleStatus, MAX_WIRE_LEN, SAMPLE_VALID,
+    self, Command, FrameReader, Gate, Hello, LinkCounters, LinkError, LoadVerdict, Loaded, Message,
+    ParamTable, Report, Sample, SampleGate, SampleStatus, MAX_WIRE_LEN, NO_PARAM, SAMPLE_VALID,
 };
 
 use super::clock::{self, ControlClock};
@@ -67,6 +72,9 @@ enum Received {
     /// The plant ended the run after this many periods (frames lost before its `End` are
     /// counted as sequence gaps).
     End(u32),
+    /// A parameter table and its frame's sequence number (before the first period; later ones
+    /// are counted as the wrong kind).
+    Params(ParamTable, u32),
 }
 
 /// The controller's input of a valid sample frame for `tick`, field by field.
@@ -111,8 +119,9 @@ impl Link {
         sent
     }
 
-    /// Waits for the sample of period `awaited`, at most [`TIMEOUT_TICKS`] SysTick periods.
-    fn receive(&mut self, awaited: u32) -> Received {
+    /// Waits for the sample of period `awaited` (or, `loading`, a parameter table), at most
+    /// [`TIMEOUT_TICKS`] SysTick periods.
+    fn receive(&mut self, awaited: u32, loading: bool) -> Received {
         let start = clock::ticks();
         for _ in 0..MAX_POLLS_PER_WAIT {
             let byte = match self.uart.try_read_byte() {
@@ -140,7 +149,7 @@ impl Link {
                 }
             };
             match frame.message {
-                Message::Sample(s) => {
+                Message::Sample(s) if !loading => {
                     match self.gate.check(frame.seq, s, awaited, &mut self.counters) {
                         Gate::Accept(s) => return Received::Sample(s),
                         Gate::Duplicate => defmt::warn!(
@@ -159,7 +168,13 @@ impl Link {
                     self.gate.close(frame.seq, &mut self.counters);
                     return Received::End(e.ticks);
                 }
-                Message::Hello(_) | Message::Command(_) | Message::Report(_) => {
+                Message::Params(table) if loading => return Received::Params(table, frame.seq),
+                Message::Sample(_)
+                | Message::Hello(_)
+                | Message::Command(_)
+                | Message::Report(_)
+                | Message::Params(_)
+                | Message::Loaded(_) => {
                     self.counters.count_error(LinkError::WrongKind);
                     defmt::warn!(
                         "link: unexpected frame kind discarded (seq={=u32})",
@@ -201,15 +216,6 @@ impl ReelDrive for CommandLink<'_> {
 ///
 /// It owns the running control clock: SysTick is the sample timeout's time base.
 pub fn run(_clock: ControlClock) -> ! {
-    let cfg = Config::paper();
-    let digest = link::config_digest(&cfg);
-    let mut controller = match Controller::new(cfg) {
-        Ok(c) => c,
-        Err(e) => {
-            defmt::error!("controller configuration rejected: {}", e);
-            exit::failure();
-        }
-    };
     let mut link = Link {
         uart: Uart::uart0(),
         reader: FrameReader::new(),
@@ -218,14 +224,15 @@ pub fn run(_clock: ControlClock) -> ! {
         seq: 0,
         send_errors: 0,
     };
+    let builtin = link::config_digest(&Config::flight());
     defmt::info!(
-        "PIL: link v{=u8} on UART0, config digest {=u32:#010x}, sample timeout {=u32} periods",
+        "PIL: link v{=u8} on UART0, built-in config digest {=u32:#010x}, sample timeout {=u32} periods",
         link::VERSION,
-        digest,
+        builtin,
         TIMEOUT_TICKS
     );
     let hello = Hello {
-        config_digest: digest,
+        config_digest: builtin,
         period_ms: CONTROL_PERIOD_MS,
         timeout_periods: TIMEOUT_TICKS as u8,
     };
@@ -233,6 +240,7 @@ pub fn run(_clock: ControlClock) -> ! {
         defmt::error!("PIL: could not send the hello frame");
         exit::failure();
     }
+    let mut controller = load(&mut link);
 
     // The plant's first sample is that of tick 0: a lost first frame is a missing sample like
     // any other (the firmware times out and steps without it), never a wait for ever.
@@ -242,8 +250,10 @@ pub fn run(_clock: ControlClock) -> ! {
     let mut digest = link::fnv1a_start();
     let mut dropouts = 0u32;
     for _ in 0..MAX_TICKS {
-        let (tick, status, reading) = match link.receive(awaited) {
+        let (tick, status, reading) = match link.receive(awaited, false) {
             Received::End(ticks) => finish(&mut link, ticks, count, digest, dropouts),
+            // Not asked for: `receive` counts a late table as the wrong kind.
+            Received::Params(..) => continue,
             Received::Sample(s) => {
                 silent = 0;
                 if s.tick > awaited {
@@ -305,6 +315,75 @@ pub fn run(_clock: ControlClock) -> ! {
     exit::failure()
 }
 
+/// Waits for the plant's parameter table and builds the controller from it, answering each
+/// table with `Loaded`; a refused table changes nothing and the next one is awaited. The plant
+/// gone silent for [`MAX_SILENT_PERIODS`], or ending the run before a table was accepted, ends
+/// the run. The plant's first sample frame is the one after the accepted table.
+fn load(link: &mut Link) -> Controller<f32> {
+    let mut silent = 0u32;
+    loop {
+        let (table, seq) = match link.receive(0, true) {
+            Received::Params(t, seq) => (t, seq),
+            Received::End(ticks) => finish(link, ticks, 0, link::fnv1a_start(), 0),
+            // (`receive` returns no sample while loading: it counts one as the wrong kind.)
+            Received::Timeout | Received::Corrupted(_) | Received::Sample(_) => {
+                silent = silent.saturating_add(1);
+                if silent > MAX_SILENT_PERIODS {
+                    defmt::error!("PIL: no parameter table for {=u32} periods", silent);
+                    exit::failure();
+                }
+                continue;
+            }
+        };
+        let (answer, controller) = match table.to_config() {
+            Err(e) => {
+                defmt::warn!("PIL: parameter table refused: {}", e);
+                let refused = Loaded {
+                    config_digest: 0,
+                    verdict: LoadVerdict::BadTable as u8,
+                    param: e.index(),
+                    rule: 0,
+                };
+                (refused, None)
+            }
+            Ok(cfg) => match Controller::new(cfg) {
+                Err(e) => {
+                    defmt::warn!("PIL: parameter table refused: {}", e);
+                    let refused = Loaded {
+                        config_digest: 0,
+                        verdict: LoadVerdict::Refused as u8,
+                        param: link::param_index(&e).unwrap_or(NO_PARAM),
+                        rule: link::rule_code(e.rule),
+                    };
+                    (refused, None)
+                }
+                Ok(c) => {
+                    let digest = link::config_digest(&cfg);
+                    defmt::info!(
+                        "PIL: parameter table loaded, config digest {=u32:#010x}",
+                        digest
+                    );
+                    let loaded = Loaded {
+                        config_digest: digest,
+                        verdict: LoadVerdict::Accepted as u8,
+                        param: NO_PARAM,
+                        rule: 0,
+                    };
+                    (loaded, Some(c))
+                }
+            },
+        };
+        if link.send(&Message::Loaded(answer)).is_err() {
+            defmt::error!("PIL: could not send the load verdict");
+            exit::failure();
+        }
+        if let Some(c) = controller {
+            link.gate = SampleGate::from_seq(seq.wrapping_add(1));
+            return c;
+        }
+    }
+}
+
 /// Answers the plant's `End` with the `Report`, logs the counters and exits with success.
 fn finish(link: &mut Link, ticks: u32, commands: u32, digest: u32, dropouts: u32) -> ! {
     defmt::info!(
@@ -320,6 +399,7 @@ fn finish(link: &mut Link, ticks: u32, commands: u32, digest: u32, dropouts: u32
     let sent = link.send(&Message::Report(report));
     let flushed = link.uart.flush();
     log_counters(link, commands, digest, dropouts);
+    super::stack::log_high_water();
     if sent.is_err() || flushed.is_err() {
         defmt::error!("PIL: the report frame could not be sent");
         exit::failure();
