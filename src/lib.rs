@@ -127,6 +127,7 @@ pub mod link;
 pub mod mass;
 pub mod monitor;
 pub mod orbit;
+pub mod pus;
 pub mod real;
 #[cfg(feature = "recordings")]
 pub mod recordings;

@@ -604,6 +604,7 @@ impl<'de> Deserialize<'de> for ParamTable {
 
 #[cfg(test)]
 mod tests {
+    extern crate std;
     use super::*;
 
     fn roundtrip(cfg: Config<f32>) {
@@ -662,6 +663,25 @@ mod tests {
             t.to_config(),
             Err(TableError::TooLarge((PARAM_WORDS - 1) as u8))
         );
+    }
+
+    /// docs/interface.md lists the table word by word, in order, with each word's kind.
+    #[test]
+    fn the_interface_document_lists_the_table() {
+        let doc = include_str!("../../docs/interface.md");
+        let mut from = 0;
+        for (i, (name, kind)) in PARAMS.iter().enumerate() {
+            let kind = match kind {
+                WordKind::F32 => "f32",
+                WordKind::U32 => "u32",
+                WordKind::Tag => "tag (0/1)",
+            };
+            let row = std::format!("| {i} | `{name}` | {kind} |");
+            let at = doc[from..]
+                .find(&row)
+                .unwrap_or_else(|| panic!("docs/interface.md lacks the row {row}"));
+            from += at + row.len();
+        }
     }
 
     #[test]
