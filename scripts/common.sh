@@ -67,3 +67,37 @@ BOARD_PANIC_ROOT='^(tss_reel_nucleo_g474re::board::Outer::control(::h[0-9a-f]+)?
 build_board() {
   cargo build --profile "$FW_PROFILE" --target "$FW_TARGET" --features "$BOARD_FEATURES" --bin "$BOARD_BIN"
 }
+
+# apt_install PACKAGE...: installs Debian packages with apt-get (as root, else through sudo),
+# without a prompt.
+apt_install() {
+  local sudo=()
+  if [[ $(id -u) -ne 0 ]]; then
+    if ! command -v sudo >/dev/null 2>&1; then
+      echo "error: $* missing and we are not root; install them with your package manager" >&2
+      return 1
+    fi
+    sudo=(sudo)
+  fi
+  "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update
+  "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends "$@"
+}
+
+# Slurm and MUNGE, for the campaign test on a one-node Slurm (scripts/slurm-test): installs the
+# Debian packages whose programs are missing. Only the programs: the test runs daemons of its
+# own, with its own configuration, and stops them.
+ensure_slurm() {
+  local missing=() pair program
+  for pair in slurmctld:slurmctld slurmd:slurmd sbatch:slurm-client munged:munge; do
+    program=${pair%%:*}
+    if ! command -v "$program" >/dev/null 2>&1 && [[ ! -x /usr/sbin/$program ]]; then
+      missing+=("${pair#*:}")
+    fi
+  done
+  if [[ ${#missing[@]} -gt 0 ]]; then
+    echo "installing ${missing[*]} (apt-get)"
+    apt_install "${missing[@]}"
+  else
+    echo "slurmctld, slurmd, sbatch and munged present: $(slurmctld -V 2>/dev/null || /usr/sbin/slurmctld -V)"
+  fi
+}

@@ -1,7 +1,9 @@
 //! `tss-sim`: the desktop simulator of the tss-reel controller.
 //!
 //! Exit codes: 0 success; 1 the run failed; 2 a usage error (bad arguments, scenario file,
-//! `--set` override or output path), reported before anything is written.
+//! `--set` override or output path), reported before anything is written; 3 a Monte Carlo
+//! campaign whose pass rate is below its `--min-pass-rate` (`montecarlo`, `merge`: every output
+//! is written).
 
 use std::process::ExitCode;
 
@@ -47,6 +49,10 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Combine the output directories of `montecarlo --shard K/N` into the whole campaign's.
     Merge(montecarlo::MergeArgs),
+    /// Campaigns on a batch system: `campaign slurm` writes (and with --submit submits) a
+    /// Monte Carlo campaign as a Slurm job array of shards and a merge job.
+    #[command(subcommand)]
+    Campaign(CampaignCommand),
     /// Print a shell completion script, e.g. `tss-sim completions bash > tss-sim.bash`.
     Completions {
         /// The shell.
@@ -56,6 +62,14 @@ enum Command {
     /// Scenario files: `scenario keys` lists every key with its unit, default and rules.
     #[command(subcommand)]
     Scenario(ScenarioCommand),
+}
+
+#[derive(Subcommand, Debug)]
+enum CampaignCommand {
+    /// Write a campaign's Slurm job scripts into DIR: the shards as a job array
+    /// (`montecarlo --shard auto`), the merge as a job that runs once every shard succeeded
+    /// (`--dependency=afterok`), and submit.sh; with --submit, submit them (docs/campaigns.md).
+    Slurm(montecarlo::SlurmArgs),
 }
 
 #[derive(Subcommand, Debug)]
@@ -100,6 +114,7 @@ fn main() -> ExitCode {
         Command::Stability(args) => analysis::run_stability(&args),
         Command::Montecarlo(args) => montecarlo::montecarlo(&args),
         Command::Merge(args) => montecarlo::merge(&args),
+        Command::Campaign(CampaignCommand::Slurm(args)) => montecarlo::campaign_slurm(&args),
         Command::Eccentric(args) => eccentric::run_eccentric(&args),
         Command::Compare(args) => compare::compare(&args),
         Command::Completions { shell } => {
@@ -119,6 +134,8 @@ fn main() -> ExitCode {
             eprintln!("error: {err:#}");
             if usage::is_usage_error(&err) || analysis::is_usage_error(&err) {
                 ExitCode::from(EXIT_USAGE)
+            } else if montecarlo::is_below_pass_rate(&err) {
+                ExitCode::from(montecarlo::EXIT_BELOW_PASS_RATE)
             } else {
                 ExitCode::from(EXIT_FAILURE)
             }

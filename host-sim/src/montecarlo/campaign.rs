@@ -1,5 +1,8 @@
 //! One campaign: the dispersed scenario of each run, the run, its outcomes and its verdict.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+
 use rayon::prelude::*;
 
 use tss_reel::controller::{Controller, Flags};
@@ -556,7 +559,7 @@ impl Campaign {
     }
 
     /// [`Campaign::run_all`], with `watch` the estimator's consistency summed over the runs
-    /// (in run order, so the sums do not depend on the thread count).
+    /// (exactly, so the sums do not depend on the thread count).
     pub fn run_all_watched(
         &self,
         indices: &[u64],
@@ -564,29 +567,64 @@ impl Campaign {
         watch: bool,
         done: &(dyn Fn() + Sync),
     ) -> anyhow::Result<(Vec<RunRecord>, Option<ConsistencySums>)> {
+        let mut records = Vec::with_capacity(indices.len());
+        let mut sums = watch.then(ConsistencySums::default);
+        self.fly_each(indices, threads, watch, &mut |record, consistency| {
+            if let (Some(sums), Some(c)) = (&mut sums, &consistency) {
+                sums.add(c);
+            }
+            records.push(record);
+            done();
+            Ok(())
+        })?;
+        records.sort_by_key(|r| r.run);
+        Ok((records, sums))
+    }
+
+    /// Flies the runs `indices` on `threads` threads (0: one per core) and hands each run to
+    /// `finished` on the calling thread as soon as it is flown, in the order they finish (with
+    /// `watch`, its NEES and NIS too). An error from `finished` stops the campaign: the runs
+    /// under way finish, no other starts, and the error is returned.
+    pub fn fly_each(
+        &self,
+        indices: &[u64],
+        threads: usize,
+        watch: bool,
+        finished: &mut dyn FnMut(RunRecord, Option<RunConsistency>) -> anyhow::Result<()>,
+    ) -> anyhow::Result<()> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .map_err(|e| anyhow::anyhow!("cannot start {threads} threads: {e}"))?;
-        let mut flown: Vec<(RunRecord, Option<RunConsistency>)> = pool.install(|| {
-            indices
-                .par_iter()
-                .map(|&i| {
-                    let r = self.fly(i, watch);
-                    done();
-                    r
+        let stop = AtomicBool::new(false);
+        let (tx, rx) = mpsc::channel();
+        std::thread::scope(|scope| {
+            let flying = scope.spawn(|| {
+                pool.install(|| {
+                    indices.par_iter().for_each_with(tx, |tx, &i| {
+                        if stop.load(Ordering::Relaxed) {
+                            return;
+                        }
+                        if tx.send(self.fly(i, watch)).is_err() {
+                            stop.store(true, Ordering::Relaxed);
+                        }
+                    })
                 })
-                .collect()
-        });
-        flown.sort_by_key(|(r, _)| r.run);
-        let sums = watch.then(|| {
-            let mut sums = ConsistencySums::default();
-            for c in flown.iter().filter_map(|(_, c)| c.as_ref()) {
-                sums.add(c);
+            });
+            let mut outcome = Ok(());
+            for (record, consistency) in rx.iter() {
+                outcome = finished(record, consistency);
+                if outcome.is_err() {
+                    stop.store(true, Ordering::Relaxed);
+                    break;
+                }
             }
-            sums
-        });
-        Ok((flown.into_iter().map(|(r, _)| r).collect(), sums))
+            drop(rx);
+            if let Err(panic) = flying.join() {
+                std::panic::resume_unwind(panic);
+            }
+            outcome
+        })
     }
 }
 

@@ -1,29 +1,47 @@
 //! `tss-sim montecarlo` and `tss-sim merge`.
 //!
-//! An output directory holds `runs.csv`, `summary.txt`, `campaign.toml` (what the campaign is:
-//! scenario fingerprint, seed, runs, shard), `scenario.toml` (the scenario as loaded) and the
-//! figures. A shard's directory holds the same for its slice; `merge` checks that its inputs
-//! are the shards of one campaign and writes what the whole campaign run at once writes
-//! (`runs.csv` and `summary.txt` byte for byte).
+//! An output directory holds `runs.csv`, `summary.txt`, `summary.json`, `campaign.toml` (what
+//! the campaign is: the build that flew it, scenario fingerprint, seed, runs, shard),
+//! `scenario.toml` (the scenario as loaded) and the figures; with `--consistency`,
+//! `consistency.csv`, `consistency.txt`, `consistency_sums.csv` (the exact sums) and a figure.
+//! While the runs fly, `runs.journal.csv` keeps each one as it finishes, so that an interrupted
+//! campaign resumes where it stopped ([`super::journal`]).
+//!
+//! A shard's directory holds the same for its slice; `merge` checks that its inputs are the
+//! shards of one campaign, flown by one build, and writes what the whole campaign run at once
+//! writes (`runs.csv`, `summary.txt`, `summary.json` and the consistency files byte for byte).
+//!
+//! Both commands fail with [`BelowPassRate`] (exit code [`EXIT_BELOW_PASS_RATE`]) when fewer
+//! runs pass than `--min-pass-rate` asks, after writing every output.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fs::File;
-use std::io::{BufReader, IsTerminal, Write};
+use std::io::{BufReader, Write};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::Context;
-use indicatif::{ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize};
 
 use super::campaign::{Campaign, RunRecord};
 use super::consistency::{self, ConsistencyFigure, ConsistencySums};
-use super::stats::{render, CampaignInfo, Shard};
+use super::journal::{journal_every, Identity, Journal, RUNS_JOURNAL};
+use super::progress::{Progress, PROGRESS_EVERY_S};
+use super::shard::{Shard, ShardSpec};
+use super::stats::{render, CampaignInfo, SummaryJson};
 use super::{plots, table};
 use crate::output::{check_output_dir, OutputSet};
 use crate::plots::{png_and_svg, write_png_and_svg};
 use crate::scenario::Scenario;
 use crate::usage::{quiet, UsageError};
+
+/// The build of this program: the git commit it was built from (`+dirty.` and a digest of the
+/// uncommitted changes to its sources, if any), or `unknown` outside a git checkout
+/// (`host-sim/build.rs`). Shards of one campaign must share it.
+pub const BUILD: &str = match option_env!("TSS_SIM_BUILD") {
+    Some(build) => build,
+    None => "unknown",
+};
 
 /// Largest `--runs`: a million runs (each run's record stays in memory until the campaign's
 /// files are written; about 0.05 s of computing each).
@@ -44,16 +62,27 @@ pub struct MonteCarloArgs {
     #[arg(long, value_name = "S", default_value_t = 0)]
     pub seed: u64,
     /// Output directory (created if needed; the files of an earlier campaign in it are
-    /// replaced).
+    /// replaced; an interrupted run of the same campaign is resumed from its journal).
     #[arg(long, short, value_name = "DIR")]
     pub out: PathBuf,
     /// Fly only shard K of N: the runs i with i mod N = K − 1 (merge the shards' directories
-    /// with `tss-sim merge`).
-    #[arg(long, value_name = "K/N", value_parser = Shard::parse)]
-    pub shard: Option<Shard>,
-    /// Worker threads (0: one per core; at most 1024). The results do not depend on it.
+    /// with `tss-sim merge`). `auto`: K and N from a Slurm job array (SLURM_ARRAY_TASK_ID,
+    /// _MIN, _MAX, _STEP and _COUNT); `auto/N`: also from a Kubernetes indexed job
+    /// (JOB_COMPLETION_INDEX, 0-based, of N).
+    #[arg(long, value_name = "K/N|auto|auto/N", value_parser = ShardSpec::parse)]
+    pub shard: Option<ShardSpec>,
+    /// Worker threads (0: one per core, or SLURM_CPUS_PER_TASK inside a Slurm job; at most
+    /// 1024). The results do not depend on it.
     #[arg(long, value_name = "T", default_value_t = 0, value_parser = threads_in_range)]
     pub threads: usize,
+    /// Exit with code 3 (after writing every output) if fewer runs pass: a fraction (0.95) or
+    /// a percentage (95%).
+    #[arg(long, value_name = "RATE", value_parser = pass_rate)]
+    pub min_pass_rate: Option<f64>,
+    /// Where stderr is not a terminal (a batch job's log), write a progress line every S
+    /// seconds (0: after every run).
+    #[arg(long, value_name = "S", default_value_t = PROGRESS_EVERY_S, value_parser = seconds)]
+    pub progress_every: f64,
     /// Do not draw the figures (e.g. for shards: `merge` draws them).
     #[arg(long)]
     pub no_figures: bool,
@@ -79,6 +108,65 @@ fn threads_in_range(text: &str) -> Result<usize, String> {
     Ok(n)
 }
 
+/// Parses `--min-pass-rate`: a fraction in [0, 1], or a percentage in [0, 100] with `%`.
+pub fn pass_rate(text: &str) -> Result<f64, String> {
+    let (number, scale) = match text.trim().strip_suffix('%') {
+        Some(percent) => (percent, 100.0),
+        None => (text.trim(), 1.0),
+    };
+    match number.trim().parse::<f64>() {
+        Ok(x) if (0.0..=scale).contains(&x) => Ok(x / scale),
+        _ => Err(format!(
+            "`{text}` is not a pass rate: a fraction in 0..=1 (0.95) or a percentage (95%)"
+        )),
+    }
+}
+
+/// Parses a non-negative, finite number of seconds.
+fn seconds(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
+        _ => Err(format!("`{text}` is not a number of seconds (0 or more)")),
+    }
+}
+
+/// Fewer runs passed than `--min-pass-rate` asks (the outputs were written): exit code 3.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "{passed} of {runs} runs pass ({:.2} %), below --min-pass-rate {:.2} % (every output is written)",
+    100.0 * *passed as f64 / (*runs).max(1) as f64,
+    100.0 * min
+)]
+pub struct BelowPassRate {
+    /// Runs that passed.
+    pub passed: usize,
+    /// Runs judged.
+    pub runs: usize,
+    /// The rate asked for.
+    pub min: f64,
+}
+
+/// The exit code of a campaign below its `--min-pass-rate`.
+pub const EXIT_BELOW_PASS_RATE: u8 = 3;
+
+/// Is `err` a campaign below its `--min-pass-rate`?
+pub fn is_below_pass_rate(err: &anyhow::Error) -> bool {
+    err.chain().any(|e| e.is::<BelowPassRate>())
+}
+
+fn check_pass_rate(records: &[RunRecord], min: Option<f64>) -> anyhow::Result<()> {
+    let passed = records.iter().filter(|r| r.passed()).count();
+    match min {
+        Some(min) if (passed as f64) < min * records.len() as f64 => Err(BelowPassRate {
+            passed,
+            runs: records.len(),
+            min,
+        }
+        .into()),
+        _ => Ok(()),
+    }
+}
+
 /// Arguments of `tss-sim merge`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct MergeArgs {
@@ -92,6 +180,10 @@ pub struct MergeArgs {
     /// Do not draw the figures.
     #[arg(long)]
     pub no_figures: bool,
+    /// Exit with code 3 (after writing every output) if fewer runs pass: a fraction (0.95) or
+    /// a percentage (95%).
+    #[arg(long, value_name = "RATE", value_parser = pass_rate)]
+    pub min_pass_rate: Option<f64>,
 }
 
 /// `campaign.toml`: what an output directory holds.
@@ -100,6 +192,8 @@ pub struct MergeArgs {
 pub struct Manifest {
     /// The tss-sim version that flew the runs.
     pub tss_sim_version: String,
+    /// Its build ([`BUILD`]).
+    pub build: String,
     /// The scenario file as given.
     pub scenario_file: String,
     /// The `--set` overrides as given.
@@ -114,6 +208,8 @@ pub struct Manifest {
     pub runs: u64,
     /// The shard, `K/N` (`1/1`: the whole campaign).
     pub shard: String,
+    /// Flown with `--consistency`.
+    pub consistency: bool,
     /// The shard directories a merged campaign was made from.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub merged_from: Vec<String>,
@@ -143,16 +239,22 @@ pub const SCENARIO_TOML: &str = "scenario.toml";
 pub const CONSISTENCY_CSV: &str = "consistency.csv";
 /// The estimator's consistency summary (`--consistency`).
 pub const CONSISTENCY_TXT: &str = "consistency.txt";
+/// The exact NEES/NIS sums (`--consistency`), which `merge` adds up.
+pub const CONSISTENCY_SUMS: &str = "consistency_sums.csv";
+/// The summary for programs.
+pub const SUMMARY_JSON: &str = "summary.json";
 
 /// Every file `montecarlo` and `merge` may write into their output directory.
 pub fn output_names() -> Vec<String> {
     let mut names: Vec<String> = [
         RUNS_CSV,
         SUMMARY_TXT,
+        SUMMARY_JSON,
         CAMPAIGN_TOML,
         SCENARIO_TOML,
         CONSISTENCY_CSV,
         CONSISTENCY_TXT,
+        CONSISTENCY_SUMS,
     ]
     .map(String::from)
     .to_vec();
@@ -161,17 +263,32 @@ pub fn output_names() -> Vec<String> {
     names
 }
 
-fn progress_bar(runs: u64) -> ProgressBar {
-    if quiet() || !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
+impl Manifest {
+    /// What the journal of this campaign's directory must say it is.
+    fn identity(&self) -> Identity {
+        Identity {
+            build: self.build.clone(),
+            fingerprint: self.scenario_fingerprint.clone(),
+            seed: self.seed.clone(),
+            runs: self.runs,
+            shard: self.shard.clone(),
+            consistency: self.consistency,
+        }
     }
-    let bar = ProgressBar::new(runs);
-    if let Ok(style) =
-        ProgressStyle::with_template("{spinner} runs [{bar:30}] {pos}/{len}, {per_sec}, eta {eta}")
-    {
-        bar.set_style(style.progress_chars("=> "));
+}
+
+/// The threads of `--threads T`: T, or if 0 SLURM_CPUS_PER_TASK inside a Slurm job, else one
+/// per core.
+fn threads(asked: usize) -> usize {
+    let slurm = std::env::var("SLURM_CPUS_PER_TASK")
+        .ok()
+        .and_then(|v| v.trim().parse::<usize>().ok())
+        .filter(|&n| (1..=MAX_THREADS).contains(&n));
+    match (asked, slurm) {
+        (0, Some(n)) => n,
+        (0, None) => rayon::current_num_threads(),
+        (t, _) => t,
     }
-    bar
 }
 
 /// `tss-sim montecarlo`.
@@ -187,7 +304,11 @@ pub fn montecarlo(args: &MonteCarloArgs) -> anyhow::Result<()> {
         .into());
     }
     check_output_dir("--out", &args.out)?;
-    let shard = args.shard.unwrap_or(Shard::WHOLE);
+    let (shard, shard_from) = args
+        .shard
+        .unwrap_or(ShardSpec::Given(Shard::WHOLE))
+        .resolve(&|name| std::env::var(name).ok())
+        .map_err(UsageError)?;
     if shard.count > args.runs {
         return Err(UsageError(format!(
             "--shard {shard}: more shards than runs (--runs {}): a shard would be empty",
@@ -198,6 +319,7 @@ pub fn montecarlo(args: &MonteCarloArgs) -> anyhow::Result<()> {
     let mut out = OutputSet::prepare("--out", &args.out, output_names())?;
     let manifest = Manifest {
         tss_sim_version: env!("CARGO_PKG_VERSION").to_string(),
+        build: BUILD.to_string(),
         scenario_file: args.scenario.display().to_string(),
         overrides: args.set.clone(),
         scenario_name: scenario.name.clone(),
@@ -205,64 +327,124 @@ pub fn montecarlo(args: &MonteCarloArgs) -> anyhow::Result<()> {
         seed: args.seed.to_string(),
         runs: args.runs,
         shard: shard.to_string(),
+        consistency: args.consistency,
         merged_from: Vec::new(),
     };
     let campaign = Campaign::new(scenario, args.seed, args.runs)?;
     let indices = shard.runs(args.runs);
-    let bar = progress_bar(indices.len() as u64);
+    let fields = campaign.fields();
+    let (mut journal, resumed) =
+        Journal::open(out.dir(), &manifest.identity(), &fields, &indices)?;
+    let mut records = resumed.records;
+    let mut sums = resumed.sums;
+    let from_journal = records.len();
+    let flown_before: BTreeSet<u64> = records.iter().map(|r| r.run).collect();
+    let todo: Vec<u64> = indices
+        .iter()
+        .copied()
+        .filter(|i| !flown_before.contains(i))
+        .collect();
+    let threads = threads(args.threads);
+    if !quiet() {
+        if let Some(why) = &resumed.replaced {
+            eprintln!("{why}");
+        }
+        let whose = match &shard_from {
+            Some(from) => format!("shard {shard} ({from})"),
+            None if shard == Shard::WHOLE => "the campaign".to_string(),
+            None => format!("shard {shard}"),
+        };
+        let journaled = if from_journal > 0 {
+            format!(
+                ", {from_journal} already flown (resumed from {})",
+                out.dir().join(RUNS_JOURNAL).display()
+            )
+        } else {
+            String::new()
+        };
+        eprintln!(
+            "{whose}: {} runs{journaled}; flying {} on {threads} thread(s), build {BUILD}",
+            indices.len(),
+            todo.len()
+        );
+    }
+    let mut progress = Progress::new(
+        indices.len() as u64,
+        from_journal as u64,
+        records.iter().filter(|r| r.passed()).count() as u64,
+        Duration::from_secs_f64(args.progress_every),
+    );
     let started = Instant::now();
-    let threads = if args.threads == 0 {
-        rayon::current_num_threads()
-    } else {
-        args.threads
-    };
-    let flown = campaign.run_all_watched(&indices, threads, args.consistency, &|| bar.inc(1));
-    bar.finish_and_clear();
-    let (records, sums) = flown?;
+    let mut batch: Vec<RunRecord> = Vec::new();
+    let mut last_append = Instant::now();
+    campaign.fly_each(&todo, threads, args.consistency, &mut |record, run_sums| {
+        if let (Some(sums), Some(run)) = (&mut sums, &run_sums) {
+            sums.add(run);
+        }
+        progress.run_done(record.passed());
+        batch.push(record);
+        if last_append.elapsed() >= journal_every() {
+            journal.append(&batch, sums.as_ref())?;
+            records.append(&mut batch);
+            last_append = Instant::now();
+        }
+        Ok(())
+    })?;
+    journal.append(&batch, sums.as_ref())?;
+    records.append(&mut batch);
+    progress.finish();
     let elapsed = started.elapsed().as_secs_f64();
-    let (report, figures) = write_outputs(
+    records.sort_by_key(|r| r.run);
+    let written = write_outputs(
         &mut out,
         &campaign.scenario,
         &manifest,
         shard,
         &records,
+        sums.as_ref(),
         !args.no_figures,
     )?;
-    let consistency = match &sums {
-        Some(sums) => write_consistency(
-            &mut out,
-            &campaign.scenario,
-            sums,
-            records.len(),
-            !args.no_figures,
-        )?,
-        None => String::new(),
-    };
     out.commit()?;
     if !quiet() {
-        print!("{report}{consistency}");
+        print!("{}{}", written.summary, written.consistency);
+        let flown = records.len() - from_journal;
+        let resumed = if from_journal > 0 {
+            format!(", {from_journal} more from the journal")
+        } else {
+            String::new()
+        };
         println!(
-            "\nFlew {} runs in {elapsed:.2} s on {threads} thread(s) ({:.1} ms per run per \
-             thread); outputs in {}",
-            records.len(),
-            1e3 * elapsed * threads as f64 / records.len().max(1) as f64,
+            "\nFlew {flown} runs in {elapsed:.2} s on {threads} thread(s) ({:.1} ms per run per \
+             thread){resumed}; outputs in {}",
+            1e3 * elapsed * threads as f64 / flown.max(1) as f64,
             args.out.display()
         );
     }
-    figures
+    written.figures?;
+    check_pass_rate(&records, args.min_pass_rate)
 }
 
-/// Writes every output of `records` (sorted by run index) into `out`; returns the summary text
-/// and the outcome of drawing the figures, if `draw_figures` (the other files are written
-/// regardless).
+/// What [`write_outputs`] wrote.
+struct Written {
+    /// The summary's text.
+    summary: String,
+    /// The consistency summary's text (empty without `--consistency`).
+    consistency: String,
+    /// Whether the figures were drawn (every other output is written regardless).
+    figures: anyhow::Result<()>,
+}
+
+/// Writes every output of `records` (sorted by run index) and, with `--consistency`, of
+/// `sums` into `out`; the figures if `draw_figures`.
 fn write_outputs(
     out: &mut OutputSet,
     sc: &Scenario,
     manifest: &Manifest,
     shard: Shard,
     records: &[RunRecord],
+    sums: Option<&ConsistencySums>,
     draw_figures: bool,
-) -> anyhow::Result<(String, anyhow::Result<()>)> {
+) -> anyhow::Result<Written> {
     let fields: Vec<&str> = sc
         .montecarlo
         .dispersion
@@ -279,9 +461,14 @@ fn write_outputs(
         seed,
         runs: manifest.runs,
         shard,
+        build: &manifest.build,
     };
     let summary = render(&info, records);
     out.write(SUMMARY_TXT, |w| w.write_all(summary.as_bytes()))?;
+    let json = SummaryJson::of(&info, records, sums.map(ConsistencySums::summary))
+        .render()
+        .context("serializing summary.json")?;
+    out.write(SUMMARY_JSON, |w| w.write_all(json.as_bytes()))?;
     let text = toml::to_string_pretty(manifest).context("serializing the manifest")?;
     out.write(CAMPAIGN_TOML, |w| {
         writeln!(
@@ -300,44 +487,54 @@ fn write_outputs(
         )?;
         w.write_all(resolved.as_bytes())
     })?;
-    let mark = out.mark();
+    let consistency = match sums {
+        Some(sums) => {
+            out.write(CONSISTENCY_CSV, |w| sums.write_csv(w))?;
+            out.write(CONSISTENCY_SUMS, |w| sums.write_sums(w))?;
+            let text = sums.summary().render(records.len());
+            out.write(CONSISTENCY_TXT, |w| w.write_all(text.as_bytes()))?;
+            text
+        }
+        None => String::new(),
+    };
     let figures = if draw_figures {
-        plots::write_figures(out, sc, &fields, records)
-            .map(|_| ())
-            .map_err(|e| {
-                out.abandon_since(mark);
-                e.context("the figures were not drawn (every other output was written)")
-            })
+        let mark = out.mark();
+        draw(out, sc, &fields, records, sums).map_err(|e| {
+            out.abandon_since(mark);
+            e.context("the figures were not drawn (every other output was written)")
+        })
     } else {
         Ok(())
     };
-    Ok((summary, figures))
+    Ok(Written {
+        summary,
+        consistency,
+        figures,
+    })
 }
 
-/// Writes the estimator's consistency (`consistency.csv`, `consistency.txt` and, if
-/// `draw_figure`, its figure) into `out`; returns the summary text.
-fn write_consistency(
+/// Draws the campaign's figures, and the consistency figure with `sums`.
+fn draw(
     out: &mut OutputSet,
     sc: &Scenario,
-    sums: &ConsistencySums,
-    runs: usize,
-    draw_figure: bool,
-) -> anyhow::Result<String> {
-    out.write(CONSISTENCY_CSV, |w| sums.write_csv(w))?;
-    let text = sums.summary().render(runs);
-    out.write(CONSISTENCY_TXT, |w| w.write_all(text.as_bytes()))?;
-    if draw_figure {
+    fields: &[&str],
+    records: &[RunRecord],
+    sums: Option<&ConsistencySums>,
+) -> anyhow::Result<()> {
+    plots::write_figures(out, sc, fields, records)?;
+    if let Some(sums) = sums {
         crate::plots::check_font()?;
         let figure = ConsistencyFigure {
             sums,
             title: format!(
-                "Estimator consistency over {runs} runs of `{}` (dashed: 95 % bands)",
+                "Estimator consistency over {} runs of `{}` (dashed: 95 % bands)",
+                records.len(),
                 sc.name
             ),
         };
         write_png_and_svg(out, consistency::FIGURE_STEM, (1200, 1200), &figure)?;
     }
-    Ok(text)
+    Ok(())
 }
 
 /// One shard directory, read and checked.
@@ -347,6 +544,7 @@ struct ShardDir {
     shard: Shard,
     scenario: Scenario,
     records: Vec<RunRecord>,
+    sums: Option<ConsistencySums>,
 }
 
 fn usage(msg: String) -> anyhow::Error {
@@ -356,6 +554,12 @@ fn usage(msg: String) -> anyhow::Error {
 fn read_shard(dir: &Path) -> anyhow::Result<ShardDir> {
     let d = dir.display();
     let path = dir.join(CAMPAIGN_TOML);
+    if !path.exists() && dir.join(RUNS_JOURNAL).exists() {
+        return Err(usage(format!(
+            "{d}: the shard has not finished (it has a {RUNS_JOURNAL} but no results yet): run \
+             its command again to resume it, then merge"
+        )));
+    }
     let text = crate::scenario::read_bounded(&path, crate::scenario::MAX_SCENARIO_BYTES)
         .map_err(|e| {
             usage(format!(
@@ -416,12 +620,23 @@ fn read_shard(dir: &Path) -> anyhow::Result<ShardDir> {
             manifest.runs
         )));
     }
+    let sums = if manifest.consistency {
+        let path = dir.join(CONSISTENCY_SUMS);
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| usage(format!("{}: cannot read: {e}", path.display())))?;
+        let sums = ConsistencySums::read_sums(&text)
+            .map_err(|e| usage(format!("{}: {e}", path.display())))?;
+        Some(sums)
+    } else {
+        None
+    };
     Ok(ShardDir {
         dir: dir.to_path_buf(),
         manifest,
         shard,
         scenario,
         records,
+        sums,
     })
 }
 
@@ -443,6 +658,13 @@ pub fn merge(args: &MergeArgs) -> anyhow::Result<()> {
                 s.dir.display()
             ))
         };
+        if m.build != f.build {
+            return Err(differ(
+                "build (rebuild once and fly every shard with that build)",
+                &f.build,
+                &m.build,
+            ));
+        }
         if m.scenario_fingerprint != f.scenario_fingerprint {
             return Err(differ(
                 "scenario (file and overrides)",
@@ -468,6 +690,13 @@ pub fn merge(args: &MergeArgs) -> anyhow::Result<()> {
                 "tss-sim version",
                 &f.tss_sim_version,
                 &m.tss_sim_version,
+            ));
+        }
+        if m.consistency != f.consistency {
+            return Err(differ(
+                "--consistency",
+                &f.consistency.to_string(),
+                &m.consistency.to_string(),
             ));
         }
     }
@@ -511,27 +740,36 @@ pub fn merge(args: &MergeArgs) -> anyhow::Result<()> {
         .flat_map(|s| s.records.iter().cloned())
         .collect();
     records.sort_by_key(|r| r.run);
+    let sums = first.sums.as_ref().map(|_| {
+        let mut total = ConsistencySums::default();
+        for s in shards.iter().filter_map(|s| s.sums.as_ref()) {
+            total.merge(s);
+        }
+        total
+    });
     let manifest = Manifest {
         shard: Shard::WHOLE.to_string(),
         merged_from: args.dirs.iter().map(|d| d.display().to_string()).collect(),
         ..f.clone()
     };
-    let (report, figures) = write_outputs(
+    let written = write_outputs(
         &mut out,
         &first.scenario,
         &manifest,
         Shard::WHOLE,
         &records,
+        sums.as_ref(),
         !args.no_figures,
     )?;
     out.commit()?;
     if !quiet() {
-        print!("{report}");
+        print!("{}{}", written.summary, written.consistency);
         println!(
             "\nMerged {count} shards ({} runs) into {}",
             records.len(),
             args.out.display()
         );
     }
-    figures
+    written.figures?;
+    check_pass_rate(&records, args.min_pass_rate)
 }

@@ -34,6 +34,7 @@ use tss_reel::estimator::{ConfigError, Drive, Estimate, Estimator, Measurement};
 use tss_reel::mass::MassModel;
 use tss_reel::Real;
 
+use super::exact_sum::ExactSum;
 use crate::history::History;
 use crate::plots::{draw_error as err, Figure, FONT};
 use crate::scenario::Scenario;
@@ -52,7 +53,7 @@ pub const NEES_DOF: f64 = 2.0;
 pub const NIS_DOF: f64 = 1.0;
 
 /// The standard-normal quantile of 0.975 (the two-sided 95 % band).
-const Z_975: f64 = 1.959_963_984_540_054;
+pub const Z_975: f64 = 1.959_963_984_540_054;
 
 /// The χ² quantile of `dof` degrees of freedom at the standard-normal quantile `z`
 /// (Wilson & Hilferty 1931: within 0.1 % of the exact quantile for dof ≥ 50, 1 % for dof ≥ 10).
@@ -253,34 +254,77 @@ pub struct RunConsistency {
     pub nis: Vec<Option<f64>>,
 }
 
-/// Sums over runs at each instant.
+/// One statistic at one instant, summed over the runs that gave a value.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct ConsistencySums {
-    /// Σ NEES and the runs that gave one, per instant.
-    pub nees: Vec<(f64, u64)>,
-    /// Σ NEES of α̇ and the runs that gave one, per instant.
-    pub rate_nees: Vec<(f64, u64)>,
-    /// Σ NIS and the runs that gave one, per instant.
-    pub nis: Vec<(f64, u64)>,
+pub struct InstantSum {
+    /// Σ of the values, exact: the same whatever the order the runs are added in.
+    pub sum: ExactSum,
+    /// Runs that gave a value.
+    pub runs: u64,
 }
 
+impl InstantSum {
+    /// The average over the runs that gave a value (`None` if none did).
+    pub fn mean(&self) -> Option<f64> {
+        (self.runs > 0).then(|| self.sum.value() / self.runs as f64)
+    }
+}
+
+/// Sums over runs at each instant. The sums are exact ([`ExactSum`]), so the runs may be added
+/// in any order, or summed shard by shard and merged ([`ConsistencySums::merge`]): the
+/// campaign's files come out the same, byte for byte.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ConsistencySums {
+    /// NEES, per instant.
+    pub nees: Vec<InstantSum>,
+    /// NEES of α̇, per instant.
+    pub rate_nees: Vec<InstantSum>,
+    /// NIS, per instant.
+    pub nis: Vec<InstantSum>,
+}
+
+/// The statistics of [`ConsistencySums`] by their names in `consistency_sums.csv`.
+const STATISTICS: [&str; 3] = ["nees", "rate_nees", "nis"];
+
 impl ConsistencySums {
+    fn statistics(&self) -> [&Vec<InstantSum>; 3] {
+        [&self.nees, &self.rate_nees, &self.nis]
+    }
+
+    fn statistics_mut(&mut self) -> [&mut Vec<InstantSum>; 3] {
+        [&mut self.nees, &mut self.rate_nees, &mut self.nis]
+    }
+
     /// Adds one run.
     pub fn add(&mut self, run: &RunConsistency) {
-        fn add_to(sums: &mut Vec<(f64, u64)>, values: &[Option<f64>]) {
+        for (sums, values) in self
+            .statistics_mut()
+            .into_iter()
+            .zip([&run.nees, &run.rate_nees, &run.nis])
+        {
             if sums.len() < values.len() {
-                sums.resize(values.len(), (0.0, 0));
+                sums.resize(values.len(), InstantSum::default());
             }
             for (s, v) in sums.iter_mut().zip(values) {
                 if let Some(v) = v {
-                    s.0 += v;
-                    s.1 += 1;
+                    s.sum.add(*v);
+                    s.runs += 1;
                 }
             }
         }
-        add_to(&mut self.nees, &run.nees);
-        add_to(&mut self.rate_nees, &run.rate_nees);
-        add_to(&mut self.nis, &run.nis);
+    }
+
+    /// Adds the runs summed in `other` (another shard's).
+    pub fn merge(&mut self, other: &ConsistencySums) {
+        for (sums, theirs) in self.statistics_mut().into_iter().zip(other.statistics()) {
+            if sums.len() < theirs.len() {
+                sums.resize(theirs.len(), InstantSum::default());
+            }
+            for (s, t) in sums.iter_mut().zip(theirs) {
+                s.sum.merge(&t.sum);
+                s.runs += t.runs;
+            }
+        }
     }
 
     /// The summary from [`SETTLED_S`] on.
@@ -302,10 +346,10 @@ impl ConsistencySums {
              rate_nees_low,rate_nees_high,nis_runs,nis_mean,nis_low,nis_high"
         )?;
         let rows = self.nees.len().max(self.nis.len());
-        let cell = |sums: &[(f64, u64)], k: usize, dof: f64| match sums.get(k) {
-            Some(&(s, n)) if n > 0 => {
-                let (lo, hi) = band(dof, n);
-                format!("{n},{},{lo},{hi}", s / n as f64)
+        let cell = |sums: &[InstantSum], k: usize, dof: f64| match sums.get(k) {
+            Some(s) if s.runs > 0 => {
+                let (lo, hi) = band(dof, s.runs);
+                format!("{},{},{lo},{hi}", s.runs, s.sum.value() / s.runs as f64)
             }
             _ => "0,,,".to_string(),
         };
@@ -321,10 +365,57 @@ impl ConsistencySums {
         }
         Ok(())
     }
+
+    /// `consistency_sums.csv`: the exact sums themselves (`statistic,instant,runs,sum`, the sum
+    /// as [`ExactSum::to_text`]), what `tss-sim merge` adds up across shards.
+    pub fn write_sums<W: Write>(&self, mut w: W) -> io::Result<()> {
+        writeln!(w, "statistic,instant,runs,sum")?;
+        for (name, sums) in STATISTICS.iter().zip(self.statistics()) {
+            for (k, s) in sums.iter().enumerate() {
+                writeln!(w, "{name},{k},{},{}", s.runs, s.sum.to_text())?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads [`ConsistencySums::write_sums`]; an error says which line is wrong.
+    pub fn read_sums(text: &str) -> Result<Self, String> {
+        let mut lines = text.lines().enumerate();
+        match lines.next() {
+            Some((_, "statistic,instant,runs,sum")) => {}
+            other => {
+                return Err(format!(
+                    "line 1: expected the header `statistic,instant,runs,sum`, found {:?}",
+                    other.map_or("", |(_, l)| l)
+                ))
+            }
+        }
+        let mut sums = ConsistencySums::default();
+        for (i, line) in lines {
+            let bad = |what: &str| format!("line {}: {what}: {line:?}", i + 1);
+            let cells: Vec<&str> = line.split(',').collect();
+            let [name, instant, runs, sum] = cells[..] else {
+                return Err(bad("expected 4 cells"));
+            };
+            let which = STATISTICS
+                .iter()
+                .position(|s| *s == name)
+                .ok_or_else(|| bad("unknown statistic"))?;
+            let target = &mut sums.statistics_mut()[which];
+            if instant.parse::<usize>() != Ok(target.len()) {
+                return Err(bad("instants out of order"));
+            }
+            target.push(InstantSum {
+                sum: ExactSum::from_text(sum).map_err(|e| bad(&e))?,
+                runs: runs.parse().map_err(|_| bad("runs is not a whole number"))?,
+            });
+        }
+        Ok(sums)
+    }
 }
 
 /// One statistic (NEES or NIS) over the settled instants.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Statistic {
     /// Degrees of freedom.
     pub dof: f64,
@@ -348,13 +439,17 @@ pub struct Statistic {
 }
 
 impl Statistic {
-    fn of(sums: &[(f64, u64)], first: usize, dof: f64) -> Self {
+    fn of(sums: &[InstantSum], first: usize, dof: f64) -> Self {
         let settled = sums.get(first..).unwrap_or(&[]);
         let (mut inside, mut below, mut above) = (0, 0, 0);
         let mut instants = 0;
         let (mut total, mut values) = (0.0, 0);
         let mut fewest = u64::MAX;
-        for &(s, n) in settled.iter().filter(|(_, n)| *n > 0) {
+        for (s, n) in settled
+            .iter()
+            .filter(|s| s.runs > 0)
+            .map(|s| (s.sum.value(), s.runs))
+        {
             instants += 1;
             let (lo, hi) = band(dof, n);
             let mean = s / n as f64;
@@ -397,7 +492,7 @@ impl Statistic {
 }
 
 /// NEES and NIS over the settled instants of a campaign.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Summary {
     /// NEES (α, α̇).
     pub nees: Statistic,
@@ -475,15 +570,14 @@ impl Figure for ConsistencyFigure<'_> {
 fn panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     name: &str,
-    sums: &[(f64, u64)],
+    sums: &[InstantSum],
     dof: f64,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let hours = |k: usize| k as f64 * EVERY_S / 3_600.0;
     let points: Vec<(f64, f64, (f64, f64))> = sums
         .iter()
         .enumerate()
-        .filter(|(_, (_, n))| *n > 0)
-        .map(|(k, &(s, n))| (hours(k), s / n as f64, band(dof, n)))
+        .filter_map(|(k, s)| s.mean().map(|mean| (hours(k), mean, band(dof, s.runs))))
         .collect();
     let t1 = points.last().map_or(1.0, |p| p.0.max(1e-3));
     // The scale shows the band well; values beyond it are clipped at its top.
@@ -577,8 +671,19 @@ mod tests {
             rate_nees: vec![],
             nis: vec![Some(1.0)],
         });
-        assert_eq!(s.nees, [(4.0, 2), (3.0, 1)]);
-        assert_eq!(s.nis, [(1.0, 1), (2.0, 1)]);
+        let pairs =
+            |v: &[InstantSum]| -> Vec<(f64, u64)> { v.iter().map(|s| (s.sum.value(), s.runs)).collect() };
+        assert_eq!(pairs(&s.nees), [(4.0, 2), (3.0, 1)]);
+        assert_eq!(pairs(&s.nis), [(1.0, 1), (2.0, 1)]);
+        // The exact sums' file reads back to the same sums.
+        let mut file = Vec::new();
+        s.write_sums(&mut file).unwrap();
+        let back = ConsistencySums::read_sums(std::str::from_utf8(&file).unwrap()).unwrap();
+        assert_eq!(back, s);
+        // Merged with another shard's: the sums of both.
+        let mut merged = back.clone();
+        merged.merge(&s);
+        assert_eq!(pairs(&merged.nees), [(8.0, 4), (6.0, 2)]);
         let mut csv = Vec::new();
         s.write_csv(&mut csv).unwrap();
         let text = String::from_utf8(csv).unwrap();

@@ -25,16 +25,32 @@
 //! [`run_seed`]`(S, i, DISPERSION_STREAM)` and flies with `sensors.seed =
 //! run_seed(S, i, SENSOR_STREAM)`: a run depends only on the scenario, the seed and its index,
 //! never on the thread count or on which shard runs it.
+//!
+//! On a cluster, `tss-sim campaign slurm` ([`slurm`]) writes the campaign as a Slurm job array
+//! of shards (`montecarlo --shard auto`, [`shard`]) and a merge job that runs once every shard
+//! has succeeded; each shard journals its runs as they finish ([`journal`]), so a shard that is
+//! killed or requeued resumes where it stopped, and `merge` checks that the shards were flown
+//! by one build on one scenario. docs/campaigns.md is the guide.
 
 pub mod campaign;
 pub mod cmd;
 pub mod consistency;
+pub mod exact_sum;
+pub mod interval;
+pub mod journal;
 pub mod plots;
+pub mod progress;
+pub mod shard;
+pub mod slurm;
 pub mod stats;
 pub mod table;
 
 pub use campaign::{run_seed, Campaign, Outcome, RunRecord, DISPERSION_STREAM, SENSOR_STREAM};
-pub use cmd::{merge, montecarlo, MergeArgs, MonteCarloArgs};
+pub use cmd::{
+    is_below_pass_rate, merge, montecarlo, MergeArgs, MonteCarloArgs, EXIT_BELOW_PASS_RATE,
+};
+pub use shard::{Shard, ShardSpec};
+pub use slurm::{campaign_slurm, SlurmArgs};
 // The `[montecarlo]` section's schema and rules are the scenario's (`crate::scenario`); they are
 // named here too, where a campaign's code looks for them.
 pub(crate) use crate::scenario::nominal_in;

@@ -4,9 +4,13 @@
 //! records (never on timing or threads), so a campaign run whole and the merge of its shards
 //! write the same bytes.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use super::campaign::{Criterion, Metric, RunRecord, WorstHealth};
+use super::consistency;
+use super::interval::{clopper_pearson, wilson, Interval, CONFIDENCE};
+use super::shard::Shard;
 use super::{Distribution, MonteCarloSection};
 use crate::scenario::Scenario;
 
@@ -14,7 +18,7 @@ use crate::scenario::Scenario;
 pub const FAILED_RUNS_LISTED: usize = 20;
 
 /// Statistics of one column over the runs where it is a finite number.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Stats {
     /// Runs with a finite value.
     pub n: usize,
@@ -102,57 +106,6 @@ pub fn sig(x: f64) -> String {
     }
 }
 
-/// Which runs a shard flies: i with i mod count = index − 1.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Shard {
-    /// K, 1-based.
-    pub index: u64,
-    /// N, the number of shards.
-    pub count: u64,
-}
-
-impl Shard {
-    /// The whole campaign.
-    pub const WHOLE: Shard = Shard { index: 1, count: 1 };
-
-    /// Does the shard fly run `i`?
-    pub fn contains(self, i: u64) -> bool {
-        i % self.count == self.index - 1
-    }
-
-    /// The runs of a campaign of `runs` runs that this shard flies, in order.
-    pub fn runs(self, runs: u64) -> Vec<u64> {
-        (self.index - 1..runs)
-            .step_by(self.count as usize)
-            .collect()
-    }
-
-    /// Parses `K/N` (1 ≤ K ≤ N).
-    pub fn parse(s: &str) -> Result<Self, String> {
-        let (k, n) = s
-            .split_once('/')
-            .ok_or_else(|| format!("--shard {s}: expected K/N, e.g. 2/8 (the K-th of N shards)"))?;
-        let parse = |t: &str, what: &str| {
-            t.trim()
-                .parse::<u64>()
-                .map_err(|_| format!("--shard {s}: {what} `{t}` is not a whole number"))
-        };
-        let (index, count) = (parse(k, "K")?, parse(n, "N")?);
-        if count == 0 || index == 0 || index > count {
-            return Err(format!(
-                "--shard {s}: K must be in 1..=N and N at least 1 (e.g. 1/4, 2/4, 3/4, 4/4)"
-            ));
-        }
-        Ok(Self { index, count })
-    }
-}
-
-impl std::fmt::Display for Shard {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}/{}", self.index, self.count)
-    }
-}
-
 /// What a campaign is, for the summary's heading.
 #[derive(Clone, Debug)]
 pub struct CampaignInfo<'a> {
@@ -166,6 +119,8 @@ pub struct CampaignInfo<'a> {
     pub runs: u64,
     /// The shard these records are.
     pub shard: Shard,
+    /// The build that flew them (`Manifest::build`).
+    pub build: &'a str,
 }
 
 fn describe_dispersion(d: &super::DispersionSection, nominal: Option<f64>) -> String {
@@ -332,6 +287,21 @@ pub fn render(info: &CampaignInfo<'_>, records: &[RunRecord]) -> String {
         0.0
     };
     let _ = writeln!(o, "Result: {passed} of {n} runs pass ({rate:.1} %)");
+    if let (Some(w), Some(cp)) = (
+        wilson(passed as u64, n as u64),
+        clopper_pearson(passed as u64, n as u64),
+    ) {
+        let _ = writeln!(
+            o,
+            "  pass rate, {:.0} % confidence: Wilson [{:.3}, {:.3}] %, Clopper–Pearson \
+             [{:.3}, {:.3}] %",
+            100.0 * CONFIDENCE,
+            100.0 * w.low,
+            100.0 * w.high,
+            100.0 * cp.low,
+            100.0 * cp.high
+        );
+    }
     let failed: Vec<&RunRecord> = records.iter().filter(|r| !r.passed()).collect();
     if !failed.is_empty() {
         let by: Vec<String> = Criterion::ALL
@@ -408,6 +378,139 @@ pub fn render(info: &CampaignInfo<'_>, records: &[RunRecord]) -> String {
     o
 }
 
+/// `summary.json`: what `summary.txt` says, for programs (a batch pipeline, a dashboard). Like
+/// the text, it depends only on the campaign and its records, so a campaign flown whole and the
+/// merge of its shards write the same bytes.
+#[derive(Debug, serde::Serialize)]
+pub struct SummaryJson<'a> {
+    /// The scenario's name.
+    pub scenario: &'a str,
+    /// Its fingerprint.
+    pub scenario_fingerprint: &'a str,
+    /// The build that flew the runs.
+    pub build: &'a str,
+    /// The seed.
+    pub seed: u64,
+    /// Runs of the whole campaign.
+    pub runs: u64,
+    /// The shard, `K/N` (`1/1`: the whole campaign).
+    pub shard: String,
+    /// Runs in this summary (the shard's).
+    pub flown: usize,
+    /// Runs that passed every criterion.
+    pub passed: usize,
+    /// passed / flown (`null` if none was flown).
+    pub pass_rate: Option<f64>,
+    /// The confidence level of the intervals below.
+    pub confidence: f64,
+    /// Wilson's score interval on the pass rate.
+    pub pass_rate_wilson: Option<Interval>,
+    /// Clopper–Pearson's exact interval on the pass rate.
+    pub pass_rate_clopper_pearson: Option<Interval>,
+    /// Each declared criterion, its rule and how many runs fail it.
+    pub criteria: Vec<CriterionJson>,
+    /// Runs that did not complete.
+    pub did_not_complete: usize,
+    /// The failed runs' indices, in order.
+    pub failed_runs: Vec<u64>,
+    /// Runs by worst controller health.
+    pub worst_health: BTreeMap<&'static str, usize>,
+    /// Statistics of each outcome over the runs where it is defined (`null`: nowhere).
+    pub outcomes: BTreeMap<&'static str, Option<Stats>>,
+    /// Statistics of each dispersed input.
+    pub inputs: BTreeMap<&'a str, Option<Stats>>,
+    /// The estimator's consistency (`--consistency`), from 30 min on.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub consistency: Option<consistency::Summary>,
+}
+
+/// A criterion in `summary.json`.
+#[derive(Debug, serde::Serialize)]
+pub struct CriterionJson {
+    /// Its name (`runs.csv`'s `failed` column).
+    pub name: &'static str,
+    /// What it requires.
+    pub rule: String,
+    /// Runs that fail it.
+    pub failed: usize,
+}
+
+impl<'a> SummaryJson<'a> {
+    /// The summary of `records` (sorted by run index) of the campaign `info`.
+    pub fn of(
+        info: &CampaignInfo<'a>,
+        records: &[RunRecord],
+        consistency: Option<consistency::Summary>,
+    ) -> Self {
+        let sc = info.scenario;
+        let n = records.len();
+        let passed = records.iter().filter(|r| r.passed()).count();
+        let failing = |c: Criterion| records.iter().filter(|r| r.failed.contains(&c)).count();
+        let stats_of = |m: Metric| {
+            Stats::of(
+                records
+                    .iter()
+                    .filter_map(|r| r.outcome.as_ref().and_then(|o| o.get(m))),
+            )
+        };
+        Self {
+            scenario: &sc.name,
+            scenario_fingerprint: info.fingerprint,
+            build: info.build,
+            seed: info.seed,
+            runs: info.runs,
+            shard: info.shard.to_string(),
+            flown: n,
+            passed,
+            pass_rate: (n > 0).then(|| passed as f64 / n as f64),
+            confidence: CONFIDENCE,
+            pass_rate_wilson: wilson(passed as u64, n as u64),
+            pass_rate_clopper_pearson: clopper_pearson(passed as u64, n as u64),
+            criteria: describe_criteria(sc)
+                .into_iter()
+                .map(|(c, rule)| CriterionJson {
+                    name: c.name(),
+                    rule,
+                    failed: failing(c),
+                })
+                .collect(),
+            did_not_complete: failing(Criterion::Completed),
+            failed_runs: records.iter().filter(|r| !r.passed()).map(|r| r.run).collect(),
+            worst_health: WorstHealth::ALL
+                .iter()
+                .map(|&h| {
+                    let k = records
+                        .iter()
+                        .filter(|r| r.outcome.as_ref().is_some_and(|o| o.worst_health == h))
+                        .count();
+                    (h.as_str(), k)
+                })
+                .collect(),
+            outcomes: Metric::ALL.iter().map(|&m| (m.name(), stats_of(m))).collect(),
+            inputs: sc
+                .montecarlo
+                .dispersion
+                .iter()
+                .enumerate()
+                .map(|(i, d)| {
+                    (
+                        d.field.as_str(),
+                        Stats::of(records.iter().map(|r| r.inputs[i])),
+                    )
+                })
+                .collect(),
+            consistency,
+        }
+    }
+
+    /// The JSON text, pretty-printed, with a final newline.
+    pub fn render(&self) -> serde_json::Result<String> {
+        let mut text = serde_json::to_string_pretty(self)?;
+        text.push('\n');
+        Ok(text)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -433,20 +536,5 @@ mod tests {
         assert_eq!(sig(2.0), "2");
         assert_eq!(sig(-1308.6591), "-1308.66");
         assert_eq!(sig(1.0e7), "1e7");
-    }
-
-    #[test]
-    fn shards_partition_the_runs() {
-        assert_eq!(Shard::parse("2/3").unwrap(), Shard { index: 2, count: 3 });
-        for bad in ["0/3", "4/3", "1/0", "x/3", "3", "1/2/3", "-1/3"] {
-            assert!(Shard::parse(bad).is_err(), "{bad}");
-        }
-        let mut all: Vec<u64> = (1..=3)
-            .flat_map(|k| Shard { index: k, count: 3 }.runs(10))
-            .collect();
-        all.sort_unstable();
-        assert_eq!(all, (0..10).collect::<Vec<_>>());
-        assert_eq!(Shard { index: 2, count: 3 }.runs(10), [1, 4, 7]);
-        assert!(Shard { index: 2, count: 3 }.contains(7));
     }
 }

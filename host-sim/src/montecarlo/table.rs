@@ -23,12 +23,31 @@ fn cell(v: Option<f64>) -> String {
     v.map(|x| x.to_string()).unwrap_or_default()
 }
 
+fn writer<W: Write>(w: W) -> csv::Writer<W> {
+    csv::WriterBuilder::new()
+        .terminator(csv::Terminator::Any(b'\n'))
+        .from_writer(w)
+}
+
 /// Writes `runs.csv` (records in the order given: sort them by run index first).
 pub fn write_runs<W: Write>(w: W, fields: &[&str], records: &[RunRecord]) -> csv::Result<()> {
-    let mut out = csv::WriterBuilder::new()
-        .terminator(csv::Terminator::Any(b'\n'))
-        .from_writer(w);
+    let mut out = writer(w);
     out.write_record(header(fields))?;
+    write_records(&mut out, records)?;
+    out.flush()?;
+    Ok(())
+}
+
+/// Writes the rows of `records` alone, as [`write_runs`] writes them after the header (the
+/// lines a campaign's journal appends).
+pub fn write_rows<W: Write>(w: W, records: &[RunRecord]) -> csv::Result<()> {
+    let mut out = writer(w);
+    write_records(&mut out, records)?;
+    out.flush()?;
+    Ok(())
+}
+
+fn write_records<W: Write>(out: &mut csv::Writer<W>, records: &[RunRecord]) -> csv::Result<()> {
     for r in records {
         let mut row = vec![r.run.to_string(), r.sensor_seed.to_string()];
         row.extend(r.inputs.iter().map(|x| x.to_string()));
@@ -45,7 +64,6 @@ pub fn write_runs<W: Write>(w: W, fields: &[&str], records: &[RunRecord]) -> csv
         row.push(r.error.clone());
         out.write_record(&row)?;
     }
-    out.flush()?;
     Ok(())
 }
 
