@@ -9,7 +9,14 @@ use std::process::Command;
 
 /// The sources whose uncommitted changes make a build dirty, relative to the workspace root:
 /// the flight core, its square-root crate, the simulator and the manifests.
-const SOURCES: [&str; 6] = ["src", "fpu", "host-sim/src", "Cargo.toml", "host-sim/Cargo.toml", "Cargo.lock"];
+const SOURCES: [&str; 6] = [
+    "src",
+    "fpu",
+    "host-sim/src",
+    "Cargo.toml",
+    "host-sim/Cargo.toml",
+    "Cargo.lock",
+];
 
 fn git(root: &Path, args: &[&str]) -> Option<String> {
     let out = Command::new("git")

@@ -333,8 +333,7 @@ pub fn montecarlo(args: &MonteCarloArgs) -> anyhow::Result<()> {
     let campaign = Campaign::new(scenario, args.seed, args.runs)?;
     let indices = shard.runs(args.runs);
     let fields = campaign.fields();
-    let (mut journal, resumed) =
-        Journal::open(out.dir(), &manifest.identity(), &fields, &indices)?;
+    let (mut journal, resumed) = Journal::open(out.dir(), &manifest.identity(), &fields, &indices)?;
     let mut records = resumed.records;
     let mut sums = resumed.sums;
     let from_journal = records.len();

@@ -297,10 +297,10 @@ impl ConsistencySums {
 
     /// Adds one run.
     pub fn add(&mut self, run: &RunConsistency) {
-        for (sums, values) in self
-            .statistics_mut()
-            .into_iter()
-            .zip([&run.nees, &run.rate_nees, &run.nis])
+        for (sums, values) in
+            self.statistics_mut()
+                .into_iter()
+                .zip([&run.nees, &run.rate_nees, &run.nis])
         {
             if sums.len() < values.len() {
                 sums.resize(values.len(), InstantSum::default());
@@ -407,7 +407,9 @@ impl ConsistencySums {
             }
             target.push(InstantSum {
                 sum: ExactSum::from_text(sum).map_err(|e| bad(&e))?,
-                runs: runs.parse().map_err(|_| bad("runs is not a whole number"))?,
+                runs: runs
+                    .parse()
+                    .map_err(|_| bad("runs is not a whole number"))?,
             });
         }
         Ok(sums)
@@ -671,8 +673,9 @@ mod tests {
             rate_nees: vec![],
             nis: vec![Some(1.0)],
         });
-        let pairs =
-            |v: &[InstantSum]| -> Vec<(f64, u64)> { v.iter().map(|s| (s.sum.value(), s.runs)).collect() };
+        let pairs = |v: &[InstantSum]| -> Vec<(f64, u64)> {
+            v.iter().map(|s| (s.sum.value(), s.runs)).collect()
+        };
         assert_eq!(pairs(&s.nees), [(4.0, 2), (3.0, 1)]);
         assert_eq!(pairs(&s.nis), [(1.0, 1), (2.0, 1)]);
         // The exact sums' file reads back to the same sums.

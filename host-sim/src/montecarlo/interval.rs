@@ -167,7 +167,8 @@ mod tests {
     /// independent of the beta function's.
     fn binomial_cdf(k: u64, n: u64, p: f64) -> f64 {
         let ln_choose = |i: u64| {
-            libm::lgamma(n as f64 + 1.0) - libm::lgamma(i as f64 + 1.0)
+            libm::lgamma(n as f64 + 1.0)
+                - libm::lgamma(i as f64 + 1.0)
                 - libm::lgamma((n - i) as f64 + 1.0)
         };
         (0..=k)
@@ -180,9 +181,15 @@ mod tests {
         // 5 of 10: Wilson [0.2366, 0.7634] (R's prop.test(5, 10, correct = FALSE)),
         // Clopper–Pearson [0.1871, 0.8129] (R's binom.test(5, 10)).
         let w = wilson(5, 10).unwrap();
-        assert!((w.low - 0.236_593).abs() < 1e-6 && (w.high - 0.763_407).abs() < 1e-6, "{w:?}");
+        assert!(
+            (w.low - 0.236_593).abs() < 1e-6 && (w.high - 0.763_407).abs() < 1e-6,
+            "{w:?}"
+        );
         let cp = clopper_pearson(5, 10).unwrap();
-        assert!((cp.low - 0.187_086).abs() < 1e-6 && (cp.high - 0.812_914).abs() < 1e-6, "{cp:?}");
+        assert!(
+            (cp.low - 0.187_086).abs() < 1e-6 && (cp.high - 0.812_914).abs() < 1e-6,
+            "{cp:?}"
+        );
         // 0 of 4: Wilson's upper end z²/(n + z²) = 0.48990; Clopper–Pearson's 1 − 0.025^(1/4).
         let w = wilson(0, 4).unwrap();
         assert_eq!(w.low, 0.0);
@@ -191,14 +198,24 @@ mod tests {
         assert!((cp.high - 0.602_364_6).abs() < 1e-6, "{cp:?}");
         // 999 of 1000: R's binom.test(999, 1000) gives [0.9944411, 0.9999747].
         let cp = clopper_pearson(999, 1000).unwrap();
-        assert!((cp.low - 0.994_441_1).abs() < 1e-7 && (cp.high - 0.999_974_7).abs() < 1e-7, "{cp:?}");
+        assert!(
+            (cp.low - 0.994_441_1).abs() < 1e-7 && (cp.high - 0.999_974_7).abs() < 1e-7,
+            "{cp:?}"
+        );
         assert_eq!(wilson(0, 0), None);
         assert_eq!(clopper_pearson(3, 0), None);
     }
 
     #[test]
     fn clopper_pearson_ends_have_tail_probability_alpha_over_two() {
-        for (k, n) in [(1, 2), (3, 7), (17, 20), (50, 100), (990, 1000), (9_990, 10_000)] {
+        for (k, n) in [
+            (1, 2),
+            (3, 7),
+            (17, 20),
+            (50, 100),
+            (990, 1000),
+            (9_990, 10_000),
+        ] {
             let cp = clopper_pearson(k, n).unwrap();
             // At the upper end, k or fewer passes have probability α/2; at the lower end, k or
             // more.
@@ -219,7 +236,10 @@ mod tests {
     fn the_documented_example() {
         let percent = |i: Interval| format!("[{:.3}, {:.3}]", 100.0 * i.low, 100.0 * i.high);
         assert_eq!(percent(wilson(9_990, 10_000).unwrap()), "[99.816, 99.946]");
-        assert_eq!(percent(clopper_pearson(9_990, 10_000).unwrap()), "[99.816, 99.952]");
+        assert_eq!(
+            percent(clopper_pearson(9_990, 10_000).unwrap()),
+            "[99.816, 99.952]"
+        );
     }
 
     #[test]

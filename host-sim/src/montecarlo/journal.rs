@@ -235,7 +235,10 @@ fn read(
     let mut seen = BTreeSet::new();
     for r in &records {
         if !ours.contains(&r.run) {
-            return Err(damaged(path, format_args!("run {} is not one of this shard's", r.run)));
+            return Err(damaged(
+                path,
+                format_args!("run {} is not one of this shard's", r.run),
+            ));
         }
         if !seen.insert(r.run) {
             return Err(damaged(path, format_args!("run {} is there twice", r.run)));

@@ -134,7 +134,9 @@ impl ShardSpec {
 /// A whole number from the environment variable `name`.
 fn number(var: &dyn Fn(&str) -> Option<String>, name: &str) -> Result<u64, String> {
     let text = var(name).ok_or_else(|| {
-        format!("--shard auto: {SLURM_TASK_ID} is set but {name} is not (a Slurm job array sets both)")
+        format!(
+            "--shard auto: {SLURM_TASK_ID} is set but {name} is not (a Slurm job array sets both)"
+        )
     })?;
     text.trim()
         .parse()
@@ -191,9 +193,10 @@ fn slurm(
 
 /// The shard of a Kubernetes indexed job's pod.
 fn kubernetes(index: &str, count: Option<u64>) -> Result<(Shard, String), String> {
-    let i: u64 = index.trim().parse().map_err(|_| {
-        format!("--shard auto: {K8S_INDEX}={index:?} is not a whole number")
-    })?;
+    let i: u64 = index
+        .trim()
+        .parse()
+        .map_err(|_| format!("--shard auto: {K8S_INDEX}={index:?} is not a whole number"))?;
     let count = count.ok_or_else(|| {
         format!(
             "--shard auto: {K8S_INDEX}={i} is set (a Kubernetes indexed job) but the number of \
@@ -227,7 +230,13 @@ mod tests {
         }
     }
 
-    fn slurm_env(id: &str, min: &str, max: &str, count: &str, step: &str) -> Vec<(&'static str, String)> {
+    fn slurm_env(
+        id: &str,
+        min: &str,
+        max: &str,
+        count: &str,
+        step: &str,
+    ) -> Vec<(&'static str, String)> {
         vec![
             (SLURM_TASK_ID, id.to_string()),
             (SLURM_TASK_MIN, min.to_string()),
@@ -263,29 +272,56 @@ mod tests {
     fn a_slurm_array_task_is_its_shard_whatever_the_first_id() {
         let s = |index, count| Shard { index, count };
         // --array=1-4 and --array=0-3: the same four shards.
-        assert_eq!(resolve("auto", &slurm_env("1", "1", "4", "4", "1")), Ok(s(1, 4)));
-        assert_eq!(resolve("auto", &slurm_env("4", "1", "4", "4", "1")), Ok(s(4, 4)));
-        assert_eq!(resolve("auto", &slurm_env("0", "0", "3", "4", "1")), Ok(s(1, 4)));
-        assert_eq!(resolve("auto/4", &slurm_env("3", "0", "3", "4", "1")), Ok(s(4, 4)));
+        assert_eq!(
+            resolve("auto", &slurm_env("1", "1", "4", "4", "1")),
+            Ok(s(1, 4))
+        );
+        assert_eq!(
+            resolve("auto", &slurm_env("4", "1", "4", "4", "1")),
+            Ok(s(4, 4))
+        );
+        assert_eq!(
+            resolve("auto", &slurm_env("0", "0", "3", "4", "1")),
+            Ok(s(1, 4))
+        );
+        assert_eq!(
+            resolve("auto/4", &slurm_env("3", "0", "3", "4", "1")),
+            Ok(s(4, 4))
+        );
         // --array=10-14 and --array=2-14:4 (tasks 2, 6, 10, 14).
-        assert_eq!(resolve("auto", &slurm_env("12", "10", "14", "5", "1")), Ok(s(3, 5)));
-        assert_eq!(resolve("auto", &slurm_env("10", "2", "14", "4", "4")), Ok(s(3, 4)));
+        assert_eq!(
+            resolve("auto", &slurm_env("12", "10", "14", "5", "1")),
+            Ok(s(3, 5))
+        );
+        assert_eq!(
+            resolve("auto", &slurm_env("10", "2", "14", "4", "4")),
+            Ok(s(3, 4))
+        );
         // No step variable: step 1.
         let mut no_step = slurm_env("2", "1", "3", "3", "1");
         no_step.pop();
         assert_eq!(resolve("auto", &no_step), Ok(s(2, 3)));
         // Given K/N wins over the environment.
-        assert_eq!(resolve("2/5", &slurm_env("1", "1", "4", "4", "1")), Ok(s(2, 5)));
+        assert_eq!(
+            resolve("2/5", &slurm_env("1", "1", "4", "4", "1")),
+            Ok(s(2, 5))
+        );
     }
 
     #[test]
     fn arrays_that_do_not_say_the_shard_are_refused() {
         // A list (--array=1,3,8): three tasks between 1 and 8.
         let e = resolve("auto", &slurm_env("3", "1", "8", "3", "1")).unwrap_err();
-        assert!(e.contains("not a range") && e.contains("--array=1-3"), "{e}");
+        assert!(
+            e.contains("not a range") && e.contains("--array=1-3"),
+            "{e}"
+        );
         // A task id off the step.
         let e = resolve("auto", &slurm_env("3", "2", "14", "4", "4")).unwrap_err();
-        assert!(e.contains("SLURM_ARRAY_TASK_ID=3 is not a task of the array 2-14:4"), "{e}");
+        assert!(
+            e.contains("SLURM_ARRAY_TASK_ID=3 is not a task of the array 2-14:4"),
+            "{e}"
+        );
         // auto/N that disagrees with the array.
         let e = resolve("auto/3", &slurm_env("1", "1", "4", "4", "1")).unwrap_err();
         assert!(e.contains("has 4 tasks, not 3"), "{e}");
@@ -295,7 +331,10 @@ mod tests {
         let e = resolve("auto", &partial).unwrap_err();
         assert!(e.contains("SLURM_ARRAY_TASK_COUNT is not"), "{e}");
         let e = resolve("auto", &slurm_env("x", "1", "4", "4", "1")).unwrap_err();
-        assert!(e.contains("SLURM_ARRAY_TASK_ID=\"x\" is not a whole number"), "{e}");
+        assert!(
+            e.contains("SLURM_ARRAY_TASK_ID=\"x\" is not a whole number"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -475,7 +475,11 @@ impl<'a> SummaryJson<'a> {
                 })
                 .collect(),
             did_not_complete: failing(Criterion::Completed),
-            failed_runs: records.iter().filter(|r| !r.passed()).map(|r| r.run).collect(),
+            failed_runs: records
+                .iter()
+                .filter(|r| !r.passed())
+                .map(|r| r.run)
+                .collect(),
             worst_health: WorstHealth::ALL
                 .iter()
                 .map(|&h| {
@@ -486,7 +490,10 @@ impl<'a> SummaryJson<'a> {
                     (h.as_str(), k)
                 })
                 .collect(),
-            outcomes: Metric::ALL.iter().map(|&m| (m.name(), stats_of(m))).collect(),
+            outcomes: Metric::ALL
+                .iter()
+                .map(|&m| (m.name(), stats_of(m)))
+                .collect(),
             inputs: sc
                 .montecarlo
                 .dispersion
