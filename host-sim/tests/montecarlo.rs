@@ -1160,3 +1160,25 @@ fn campaign_slurm_writes_job_scripts_that_fly_and_merge_the_campaign() {
         stderr(&o)
     );
 }
+
+/// While a campaign flies, its directory is locked: a second process on it (a requeued job
+/// whose first copy still runs) is refused (exit 2) instead of interleaving the journal.
+#[test]
+fn a_directory_another_campaign_is_flying_in_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("mc");
+    std::fs::create_dir_all(&out).unwrap();
+    let held = std::fs::File::create(out.join("campaign.lock")).unwrap();
+    held.try_lock().expect("the test holds the lock");
+    let o = montecarlo_env(&out, "2", "1", &SHORT, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("another tss-sim is flying a campaign in"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.join("runs.csv").exists());
+    held.unlock().unwrap();
+    let o = montecarlo_env(&out, "2", "1", &SHORT, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}

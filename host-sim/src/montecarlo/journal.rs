@@ -17,6 +17,10 @@
 //! build, scenario, seed, size or shard) is replaced: that campaign starts from its first run.
 //! The journal stays beside the results once the campaign is done: rerunning the command then
 //! flies nothing and writes the same files again.
+//!
+//! While it flies, a campaign holds an exclusive lock on `campaign.lock` in its directory: a
+//! second process on the same directory (a requeued job whose first copy still runs) is refused
+//! rather than interleaving its rows with the first's.
 
 use std::collections::BTreeSet;
 use std::fs::{File, OpenOptions};
@@ -29,11 +33,14 @@ use anyhow::Context as _;
 use super::campaign::RunRecord;
 use super::consistency::ConsistencySums;
 use super::table;
+use crate::usage::UsageError;
 
 /// The journal of runs.
 pub const RUNS_JOURNAL: &str = "runs.journal.csv";
 /// The checkpoint of the consistency sums (`--consistency`).
 pub const CONSISTENCY_CHECKPOINT: &str = "consistency.checkpoint.csv";
+/// The file a flying campaign holds locked.
+pub const LOCK: &str = "campaign.lock";
 
 /// The longest a finished run waits before its row is appended and flushed, s.
 pub const JOURNAL_EVERY_S: f64 = 1.0;
@@ -84,6 +91,8 @@ pub struct Resumed {
 #[derive(Debug)]
 pub struct Journal {
     dir: PathBuf,
+    /// Held locked until the journal is dropped (and by the system until the process ends).
+    _lock: File,
     file: File,
     first_line: String,
     rows: u64,
@@ -110,6 +119,7 @@ impl Journal {
         fields: &[&str],
         runs: &[u64],
     ) -> anyhow::Result<(Self, Resumed)> {
+        let lock = lock(dir)?;
         let first_line = identity(id);
         let path = dir.join(RUNS_JOURNAL);
         let mut resumed = match std::fs::read(&path) {
@@ -149,6 +159,7 @@ impl Journal {
             .with_context(|| format!("opening {}", path.display()))?;
         let journal = Self {
             dir: dir.to_path_buf(),
+            _lock: lock,
             file,
             first_line,
             rows: resumed.records.len() as u64,
@@ -192,6 +203,28 @@ impl Journal {
         std::fs::rename(&tmp, &path)
             .with_context(|| format!("renaming {} to {}", tmp.display(), path.display()))?;
         sync_dir(&self.dir).with_context(|| format!("flushing {}", self.dir.display()))
+    }
+}
+
+/// Locks `dir`'s [`LOCK`] for this process; refused if another process holds it. A file
+/// system without locks is not an error (the campaign then relies on one process a directory).
+fn lock(dir: &Path) -> anyhow::Result<File> {
+    let path = dir.join(LOCK);
+    let file = OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&path)
+        .with_context(|| format!("opening {}", path.display()))?;
+    match file.try_lock() {
+        Ok(()) | Err(std::fs::TryLockError::Error(_)) => Ok(file),
+        Err(std::fs::TryLockError::WouldBlock) => Err(UsageError(format!(
+            "{}: another tss-sim is flying a campaign in {} (it holds {LOCK}); wait for it to \
+             end, or stop it",
+            path.display(),
+            dir.display()
+        ))
+        .into()),
     }
 }
 
