@@ -160,6 +160,118 @@ pub struct Config<T> {
     pub protection: Option<ProtectionConfig<T>>,
     /// Where the law's α and α̇ come from.
     pub rate_source: RateSource<T>,
+    /// The tension loop between the law and the envelope (docs/equations.md §17); `None`: the
+    /// paper's controller, which does not read the load cell for the law.
+    pub tension_loop: Option<TensionLoopConfig<T>>,
+}
+
+/// The tension loop's parameters (docs/equations.md §17, `Config::tension_loop`): the admittance
+/// term that damps the tether's longitudinal mode, the tension window that shapes the law's
+/// command, the attitude's share of authority and the load cell's failure.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TensionLoopConfig<T> {
+    /// EA, the tether's axial stiffness as the loop is told it, N (the gain schedule (17.5);
+    /// known to ±50 %, §17.3).
+    pub axial_stiffness_n: T,
+    /// ζ_d, the damping ratio the admittance term gives the tether's bounce (17.4), in (0, 2].
+    pub damping_ratio: T,
+    /// τ_w, the washout's time constant, s: slower than the bounce, faster than the law
+    /// (17.3; at least the period).
+    pub washout_s: T,
+    /// T_lo, the least mean tension the window keeps when it limits a braking (17.8), N (≥ 0).
+    pub min_tension_n: T,
+    /// T_hi, the most mean tension the window allows when it limits a wind-in's start (17.8), N:
+    /// below the drum motor's torque limit at the tether.
+    pub max_tension_n: T,
+    /// κ, the elastic overshoot allowance of the window (17.8), ≥ 1.
+    pub overshoot: T,
+    /// The window on either side without a load cell (before its first sample, and once it is
+    /// lost), m/s² (> 0; §17.6).
+    pub fallback_accel_mps2: T,
+    /// Periods without a load-cell sample after which the load cell is lost (§17.6; ≥ 1).
+    pub load_cell_timeout_ticks: u32,
+    /// |δ| from which the attitude takes authority from the tension window, rad (§17.5; > 0).
+    pub yield_from_rad: T,
+    /// |δ| from which the law flies unshaped (envelope only), rad (> `yield_from_rad`).
+    pub yield_full_rad: T,
+}
+
+impl<T: Real> TensionLoopConfig<T> {
+    /// The loop for the 0.5 mm Dyneema of `scenarios/paper-elastic.toml` (EA = 10 kN) on the
+    /// paper's masses (docs/equations.md §17): ζ_d = 0.6, τ_w = 100 s, the mean tension kept in
+    /// [0.1 N, 15 N] (the drum's motor holds 20 N at the tether) with κ = 1.5, a fallback of
+    /// 4.5e-3 m/s² (the 2-km keep's 0.67 N on 99 kg at κ = 1.5), the load cell lost after 5
+    /// periods without a sample, the attitude's share from |δ| = 0.2 rad to 0.5 rad.
+    pub fn dyneema_half_mm() -> Self {
+        Self {
+            axial_stiffness_n: T::from_f64(10_000.0),
+            damping_ratio: T::from_f64(0.6),
+            washout_s: T::from_f64(100.0),
+            min_tension_n: T::from_f64(0.1),
+            max_tension_n: T::from_f64(18.0),
+            overshoot: T::from_f64(1.5),
+            fallback_accel_mps2: T::from_f64(4.5e-3),
+            load_cell_timeout_ticks: 5,
+            yield_from_rad: T::from_f64(0.5),
+            yield_full_rad: T::from_f64(1.0),
+        }
+    }
+
+    /// Checks the parameters against the control period `period_s`.
+    pub fn validate(&self, period_s: T) -> Result<(), ConfigError> {
+        positive("tension_loop.axial_stiffness_n", self.axial_stiffness_n)?;
+        positive("tension_loop.damping_ratio", self.damping_ratio)?;
+        if self.damping_ratio > T::from_f64(2.0) {
+            return Err(ConfigError::new(
+                "tension_loop.damping_ratio",
+                self.damping_ratio,
+                Rule::OutOfRange,
+            ));
+        }
+        positive("tension_loop.washout_s", self.washout_s)?;
+        if self.washout_s < period_s {
+            return Err(ConfigError::new(
+                "tension_loop.washout_s",
+                self.washout_s,
+                Rule::BelowMinimum,
+            ));
+        }
+        at_least("tension_loop.min_tension_n", self.min_tension_n, T::ZERO)?;
+        above(
+            "tension_loop.max_tension_n",
+            self.max_tension_n,
+            self.min_tension_n,
+        )?;
+        if self.max_tension_n > T::from_f64(MAX_PLAUSIBLE_TENSION_N) {
+            return Err(ConfigError::new(
+                "tension_loop.max_tension_n",
+                self.max_tension_n,
+                Rule::TooLarge,
+            ));
+        }
+        finite("tension_loop.overshoot", self.overshoot)?;
+        if self.overshoot < T::ONE {
+            return Err(ConfigError::new(
+                "tension_loop.overshoot",
+                self.overshoot,
+                Rule::BelowMinimum,
+            ));
+        }
+        positive(
+            "tension_loop.fallback_accel_mps2",
+            self.fallback_accel_mps2,
+        )?;
+        positive(
+            "tension_loop.load_cell_timeout_ticks",
+            T::from_u32(self.load_cell_timeout_ticks),
+        )?;
+        positive("tension_loop.yield_from_rad", self.yield_from_rad)?;
+        above(
+            "tension_loop.yield_full_rad",
+            self.yield_full_rad,
+            self.yield_from_rad,
+        )
+    }
 }
 
 /// Where the law's α and α̇ come from.
@@ -211,16 +323,20 @@ impl<T: Real> Config<T> {
             monitor: MonitorConfig::default_for_period(),
             protection: None,
             rate_source: RateSource::Sensor,
+            tension_loop: None,
         }
     }
 
     /// The paper's mission ([`Config::paper`]) as it flies: on the onboard estimator's α̂ and α̇̂
     /// from the swing sensor's α alone ([`RateSource::Estimator`] with
-    /// [`estimator::Config::paper`]: σ_α = 1e-4 rad at 1 s), since no flight sensor measures α̇.
-    /// The flight firmware's configuration.
+    /// [`estimator::Config::paper`]: σ_α = 1e-4 rad at 1 s), since no flight sensor measures α̇,
+    /// and with the tension loop that holds a real tether taut
+    /// ([`TensionLoopConfig::dyneema_half_mm`], docs/equations.md §17). The flight firmware's
+    /// configuration.
     pub fn flight() -> Self {
         Self {
             rate_source: RateSource::Estimator(estimator::Config::paper()),
+            tension_loop: Some(TensionLoopConfig::dyneema_half_mm()),
             ..Self::paper()
         }
     }
@@ -290,6 +406,9 @@ impl<T: Real> Config<T> {
         self.monitor.validate()?;
         if let Some(p) = &self.protection {
             p.validate(self.period_s)?;
+        }
+        if let Some(t) = &self.tension_loop {
+            t.validate(self.period_s)?;
         }
         positive("envelope.max_rate_mps", env.max_rate_mps)?;
         positive("envelope.max_accel_mps2", env.max_accel_mps2)?;

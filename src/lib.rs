@@ -78,6 +78,7 @@
 //! | [`law`] | Eqs. 26–30 | the range-rate law solved implicitly with the Eq. 29 blend; the Eq. 30 acceleration | §5 |
 //! | [`schedule`] | Eqs. 34, 35 | α_r(l) with quintic Hermite transitions; the stage-2 slew | §6 |
 //! | [`config`] | §6 | the parameters, the paper's scenario, validation | §7 |
+//! | [`tension`] | — | the tension loop: admittance gain, washout, tension window | §17 |
 //! | [`controller`] | — | the step: sequencer, health, safe actions, events, output | §12 |
 //! | [`monitor`] | — | sensor checks (range, jumps, stuck) | §12 |
 //! | [`envelope`] | — | rate, acceleration and length limits (a discrete braking staircase) | §10 |
@@ -134,6 +135,7 @@ pub mod recordings;
 pub mod reel_drive;
 pub mod schedule;
 pub mod stability;
+pub mod tension;
 
 pub use real::Real;
 

@@ -1,5 +1,6 @@
-//! `tss-sim compare SCENARIO --laws paper,rupp,tracking [--runs N [--seed S]] [-o DIR]`: flies
-//! each law (`[controller] law`, `crate::laws`) on the same scenario — and with `--runs` on the
+//! `tss-sim compare SCENARIO --laws paper,paper+loop,rupp,tracking [--runs N [--seed S]] [-o DIR]`:
+//! flies each law (`[controller] law`, `crate::laws`; the paper's without its tension loop,
+//! `paper`, and with it, `paper+loop`: docs/equations.md §17) on the same scenario — and with `--runs` on the
 //! same dispersed campaign (the scenario's `[montecarlo]` dispersions, the same seeds for every
 //! law) — and writes one table (`compare.txt`, `compare.csv`), the runs (`compare_runs.csv`,
 //! with `--runs`) and overlaid figures of the nominal runs (`compare.png`/`.svg`: length, α,
@@ -12,7 +13,9 @@
 //! - largest libration: max |α| over the run (α wrapped to (−180°, 180°]), and the libration
 //!   after arrival: max |α| from the arrival to the end of stage 1;
 //! - final speed: |l̇| at the end of the run (the plant's, from the last two samples);
-//! - tension range over the run (the minimum over every control tick), slack time and episodes;
+//! - tension range over the run (the minimum over every control tick), slack time and episodes,
+//!   each from the point the tether must be taut on (`simulation.taut_from_length_m`,
+//!   docs/equations.md §17.7; from the start by default);
 //! - reel energy: ∫ T |l̇| dt, the work the tether does on (paying out) or against (winding in)
 //!   the reel, from the recorded samples (trapezoid in T over each sample's Δl): what a brake
 //!   dissipates and a motor supplies, not the motor's electrical energy;
@@ -51,8 +54,9 @@ pub const MAX_RUNS: u64 = 100_000;
 pub struct CompareArgs {
     /// Scenario file (TOML), e.g. scenarios/seds2.toml.
     pub scenario: PathBuf,
-    /// The laws to fly, comma-separated: paper, rupp, tracking.
-    #[arg(long, value_delimiter = ',', default_value = "paper,rupp,tracking")]
+    /// The laws to fly, comma-separated: paper (without the tension loop), paper+loop (with
+    /// the scenario's `[tension_loop]`), rupp, tracking.
+    #[arg(long, value_delimiter = ',', default_value = "paper,paper+loop,rupp,tracking")]
     pub laws: Vec<String>,
     /// Fly each law on this many runs of the scenario's `[montecarlo]` campaign (same seeds for
     /// every law) besides the nominal run.
@@ -67,6 +71,49 @@ pub struct CompareArgs {
     /// Override one scenario field, dotted key and TOML value (repeatable).
     #[arg(long = "set", short = 's', value_name = "KEY=VALUE")]
     pub set: Vec<String>,
+}
+
+/// What `--laws` names: a law, and for the paper's law whether its tension loop flies
+/// (`[tension_loop] enabled`; the tension laws command the tension themselves, without it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Contender {
+    /// The law.
+    pub law: LawName,
+    /// The paper's law flies with its tension loop (docs/equations.md §17).
+    pub tension_loop: bool,
+}
+
+impl Contender {
+    /// Every contender, in the order `tss-sim compare` lists them.
+    pub const ALL: [Contender; 4] = [
+        Contender::without_loop(LawName::Paper),
+        Contender {
+            law: LawName::Paper,
+            tension_loop: true,
+        },
+        Contender::without_loop(LawName::Rupp),
+        Contender::without_loop(LawName::Tracking),
+    ];
+
+    const fn without_loop(law: LawName) -> Self {
+        Self {
+            law,
+            tension_loop: false,
+        }
+    }
+
+    /// The name on the command line and in the outputs.
+    pub fn as_str(self) -> &'static str {
+        match (self.law, self.tension_loop) {
+            (LawName::Paper, true) => "paper+loop",
+            (law, _) => law.as_str(),
+        }
+    }
+
+    /// The contender named `s`, if any.
+    pub fn parse(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|c| c.as_str() == s)
+    }
 }
 
 /// What one run of one law did (see the module doc).
@@ -141,13 +188,13 @@ impl LawMetrics {
             max_libration_deg: samples.iter().map(abs_alpha).fold(0.0, f64::max),
             libration_after_deg: libration_after,
             final_speed_mps: final_speed,
-            min_tension_n: f.min_tension_n.0,
+            min_tension_n: f.taut.min_tension_n.0,
             max_tension_n: samples
                 .iter()
                 .map(|x| x.tension_n)
                 .fold(f64::NEG_INFINITY, f64::max),
-            slack_s: f.slack_s,
-            slack_episodes: f64::from(f.slack_events),
+            slack_s: f.taut.slack_s,
+            slack_episodes: f64::from(f.taut.slack_events),
             reel_energy_j: energy,
             keep_error_m: outcome.get(Metric::Keep1Error),
             passed: outcome.failed(&sc.montecarlo).is_empty(),
@@ -176,8 +223,8 @@ impl LawMetrics {
 /// One law's row of the table: the nominal run, and with `--runs` the campaign.
 #[derive(Clone, Debug)]
 pub struct LawRow {
-    /// The law.
-    pub law: LawName,
+    /// The law (and its tension loop).
+    pub law: Contender,
     /// Its nominal run.
     pub nominal: LawMetrics,
     /// Its campaign runs (run index, metrics; `None` if the run did not complete).
@@ -238,13 +285,13 @@ pub fn render_table(sc: &Scenario, rows: &[LawRow]) -> String {
         "Laws compared on scenario `{}` (target {} m; nominal run)",
         sc.name, sc.stage1.keep_length_m
     );
-    let _ = write!(out, "{:<10}", "law");
+    let _ = write!(out, "{:<11}", "law");
     for h in headers {
         let _ = write!(out, " {h:>w$}", w = width(h));
     }
     out.push('\n');
     for r in rows {
-        let _ = write!(out, "{:<10}", r.law.as_str());
+        let _ = write!(out, "{:<11}", r.law.as_str());
         for (h, v) in r.nominal.columns() {
             let _ = write!(out, " {:>w$}", cell(v), w = width(h));
         }
@@ -257,7 +304,7 @@ pub fn render_table(sc: &Scenario, rows: &[LawRow]) -> String {
             "\nMedians over {n} dispersed runs (same seeds for every law); pass = pass rate"
         );
         for r in rows {
-            let _ = write!(out, "{:<10}", r.law.as_str());
+            let _ = write!(out, "{:<11}", r.law.as_str());
             for (i, h) in headers.iter().enumerate().take(headers.len() - 1) {
                 let _ = write!(out, " {:>w$}", cell(r.median(i)), w = width(h));
             }
@@ -325,13 +372,13 @@ pub fn output_names() -> Vec<String> {
 }
 
 /// The laws named on the command line, in order; a law named twice is refused.
-pub fn parse_laws(names: &[String]) -> Result<Vec<LawName>, UsageError> {
+pub fn parse_laws(names: &[String]) -> Result<Vec<Contender>, UsageError> {
     let mut laws = Vec::new();
     for n in names {
-        let law = LawName::parse(n.trim()).ok_or_else(|| {
+        let law = Contender::parse(n.trim()).ok_or_else(|| {
             UsageError(format!(
                 "--laws: unknown law {n:?} (the laws: {})",
-                LawName::ALL.map(LawName::as_str).join(", ")
+                Contender::ALL.map(Contender::as_str).join(", ")
             ))
         })?;
         if laws.contains(&law) {
@@ -349,9 +396,10 @@ pub fn parse_laws(names: &[String]) -> Result<Vec<LawName>, UsageError> {
 }
 
 /// `sc` flown by `law`, validated (a tension law on the elastic plant needs the motor reel).
-fn with_law(sc: &Scenario, law: LawName) -> Result<Scenario, UsageError> {
+fn with_law(sc: &Scenario, law: Contender) -> Result<Scenario, UsageError> {
     let mut s = sc.clone();
-    s.controller.law = law;
+    s.controller.law = law.law;
+    s.tension_loop.enabled = law.tension_loop;
     let problems = s.problems();
     if problems.is_empty() {
         Ok(s)
@@ -478,11 +526,12 @@ fn campaign_runs(
 struct Overlay<'a> {
     scenario: String,
     stage2_s: f64,
-    runs: &'a [(LawName, History)],
+    runs: &'a [(Contender, History)],
 }
 
-const LAW_COLORS: [RGBColor; 3] = [
+const LAW_COLORS: [RGBColor; 4] = [
     RGBColor(0x1f, 0x77, 0xb4),
+    RGBColor(0x94, 0x67, 0xbd),
     RGBColor(0xd6, 0x27, 0x28),
     RGBColor(0x2c, 0xa0, 0x2c),
 ];
@@ -513,7 +562,7 @@ impl Figure for Overlay<'_> {
         ];
         let areas = root.split_evenly((panels.len(), 1));
         for (area, (title, y_desc, series)) in areas.iter().zip(panels) {
-            let curves: Vec<(LawName, Vec<(f64, f64)>)> = self
+            let curves: Vec<(Contender, Vec<(f64, f64)>)> = self
                 .runs
                 .iter()
                 .map(|(law, h)| (*law, series(&h.samples)))
@@ -553,7 +602,7 @@ fn draw_panel<DB: DrawingBackend>(
     caption: &str,
     y_desc: &str,
     stage2_h: f64,
-    curves: &[(LawName, Vec<(f64, f64)>)],
+    curves: &[(Contender, Vec<(f64, f64)>)],
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let all = || curves.iter().flat_map(|c| c.1.iter());
     let (x0, x1) = padded(all().map(|p| p.0));
@@ -581,7 +630,7 @@ fn draw_panel<DB: DrawingBackend>(
         ))?;
     }
     for (law, points) in curves {
-        let color = LAW_COLORS[LawName::ALL.iter().position(|l| l == law).unwrap_or(0)];
+        let color = LAW_COLORS[Contender::ALL.iter().position(|l| l == law).unwrap_or(0)];
         for (i, piece) in pieces(points).into_iter().enumerate() {
             let drawn = chart.draw_series(LineSeries::new(piece, color.stroke_width(2)))?;
             if i == 0 {

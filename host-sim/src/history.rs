@@ -104,7 +104,7 @@ pub struct SpoolOverrun {
 
 /// The controller's flag bits (`tss_reel::controller::Flags`, the `flags` column of
 /// `history.csv`) and their names, in bit order.
-pub const FLAG_NAMES: [(u32, &str); 11] = [
+pub const FLAG_NAMES: [(u32, &str); 13] = [
     (Flags::RATE_SATURATED, "rate-saturated"),
     (Flags::ACCEL_SATURATED, "accel-saturated"),
     (Flags::LENGTH_LIMITED, "length-limited"),
@@ -116,6 +116,8 @@ pub const FLAG_NAMES: [(u32, &str); 11] = [
     (Flags::NO_PROGRESS, "no-progress"),
     (Flags::TENSION_LIMITED, "tension-limited"),
     (Flags::PHASE_CHANGED, "phase-changed"),
+    (Flags::TENSION_SHAPED, "tension-shaped"),
+    (Flags::LOAD_CELL_LOST, "load-cell-lost"),
 ];
 
 /// The names of the bits set in `flags`, joined by `|` (e.g. `slewing|no-equilibrium`;

@@ -117,7 +117,8 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
         ..History::default()
     };
     let mut injector = Injector::new(&InjectionPlan::from(sc), period);
-    let mut summary = SummaryBuilder::new(period, &sc.envelope.to_envelope());
+    let mut summary = SummaryBuilder::new(period, &sc.envelope.to_envelope())
+        .taut_from_length(sc.simulation.taut_from_length_m);
     let mut next_probe = 0;
     // The command held over the last period (before the first: the release rate), and the
     // encoder's length at the start of it: the reel's truth at the end of the period.

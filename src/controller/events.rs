@@ -37,6 +37,9 @@ pub enum EventKind {
     /// The protection's tension bound began to restrict the command
     /// ([`super::Flags::TENSION_LIMITED`], set at this step and not at the one before).
     TensionLimited,
+    /// The tension loop's mode changed (docs/equations.md §17.6): its load cell came, coasted,
+    /// was lost or came back.
+    TensionLoop(super::TensionLoopMode),
 }
 
 /// An event and the tick it happened at.

@@ -37,6 +37,7 @@
 //!   estimate  α and α̇: sensed, or the onboard EKF's             → Sensed
 //!   sequence  stages, phases, α_r (sequencer)                    → Reference
 //!   law       Eqs. 27 + 29 and the Eq. 30 acceleration           → Solved (the demand)
+//!   shape     the tension loop (docs/equations.md §17)            → Shaped (the demand)
 //!   limit     the envelope and the protection's bounds           → Decided (the command)
 //!   report    the output, and the events of what changed since the last report
 //! ```
@@ -76,6 +77,7 @@ mod health;
 mod output;
 pub(crate) mod protection;
 mod sequencer;
+mod tension;
 
 use crate::envelope::{Bounds, PreparedEnvelope};
 use crate::equilibrium::ExistenceMonitor;
@@ -87,7 +89,7 @@ use crate::schedule::Reference;
 
 pub use crate::config::{
     Config, ConfigError, MonitorConfig, ProtectionConfig, RateSource, Rule, Stage1Config,
-    Stage2Config, MAX_PLAUSIBLE_TENSION_N,
+    Stage2Config, TensionLoopConfig, MAX_PLAUSIBLE_TENSION_N,
 };
 pub use crate::envelope::Envelope;
 pub use crate::monitor::{Input, Sensor};
@@ -101,6 +103,9 @@ use events::EventQueue;
 use health::{DeadReckoning, HealthMachine};
 use protection::{FreeTensionModel, Protection};
 use sequencer::Sequencer;
+use tension::{StageInput, TensionStage};
+
+pub use tension::TensionLoopMode;
 
 pub use estimation::{MAX_ALPHA_VARIANCE_IN_SAMPLES, MAX_CARRIED_PERIODS};
 pub use sequencer::PROGRESS_TIME_CONSTANTS;
@@ -120,6 +125,8 @@ pub struct Controller<T: Real> {
     monitor: Monitor<T>,
     /// The estimator the law flies on (`None`: it flies on the sensed α̇).
     estimation: Option<Estimation<T>>,
+    /// The tension loop between the law and the limits (None: not configured).
+    tension: Option<TensionStage<T>>,
     sequencer: Sequencer<T>,
     health: HealthMachine,
     length: DeadReckoning<T>,
@@ -204,6 +211,15 @@ struct Solved<T> {
     free_tension: Option<FreeTensionModel<T>>,
 }
 
+/// The law's demand after the tension loop (docs/equations.md §17): shaped to what the tether
+/// carries, with the admittance term that damps its bounce; the law's own without a loop.
+#[derive(Clone, Copy, Debug)]
+struct Shaped<T> {
+    demand: Command<T>,
+    /// [`Flags::TENSION_SHAPED`], [`Flags::LOAD_CELL_LOST`].
+    flags: Flags,
+}
+
 /// A step's command, limited, with what the report says about it.
 #[derive(Clone, Copy, Debug)]
 struct Decided<T> {
@@ -282,6 +298,14 @@ impl<T: Real> Controller<T> {
             existence,
             monitor: Monitor::new(spool_m, estimation.is_none())?,
             estimation,
+            tension: cfg.tension_loop.map(|t| {
+                TensionStage::new(
+                    t,
+                    cfg.masses,
+                    cfg.period_s,
+                    cfg.envelope.max_accel_mps2,
+                )
+            }),
             reported: Reported {
                 health: Health::Nominal,
                 phase: sequencer.phase(),
@@ -391,8 +415,8 @@ impl<T: Real> Controller<T> {
         &self.out
     }
 
-    /// The command of one period: check → estimate → sequence → law → limit, or the safe
-    /// action where a stage finds nothing the law may fly on.
+    /// The command of one period: check → estimate → sequence → law → shape → limit, or the
+    /// safe action where a stage finds nothing the law may fly on.
     fn decide(&mut self, tick: u32, sample: Option<&Input<T>>) -> Decided<T> {
         let period = match self.clock.advance(tick) {
             Ok(elapsed) => self.begin_period(tick, elapsed, sample),
@@ -414,7 +438,8 @@ impl<T: Real> Controller<T> {
             Err(unusable) => return self.reject(tick, unusable),
         };
         self.advance_phase(tick, &sensed, &reference);
-        self.limit(&sensed, &reference, &solved)
+        let shaped = self.shape(tick, &sensed, &solved);
+        self.limit(&sensed, &reference, &solved, &shaped)
     }
 
     /// The start of a period in which time moved to `tick`: the mission's stages begin when
@@ -612,19 +637,67 @@ impl<T: Real> Controller<T> {
             .advance_phase(tick, s.input.length_m, reference.slewing);
     }
 
-    /// Limit the law's demand to the envelope and the protection's bounds. The acceleration
+    /// The tension loop (docs/equations.md §17): the law's demand shaped to the accelerations
+    /// the tether carries, plus the admittance term that damps its bounce, from the sample's
+    /// load cell. A change of the loop's mode is an event at `tick`. Without a loop, the law's
+    /// demand as it is.
+    fn shape(&mut self, tick: u32, s: &Sensed<T>, solved: &Solved<T>) -> Shaped<T> {
+        let mut flags = Flags::default();
+        let Some(stage) = &mut self.tension else {
+            return Shaped {
+                demand: solved.demand,
+                flags,
+            };
+        };
+        let out = stage.step(&StageInput {
+            law_rate_mps: solved.demand.rate_mps,
+            law_accel_mps2: solved.demand.accel_mps2,
+            previous_mps: self.last_command.rate_mps,
+            length_m: s.input.length_m,
+            delta_rad: solved.parts.delta_rad,
+            tension_n: s.input.tension_n,
+        });
+        flags.set_if(out.shaped, Flags::TENSION_SHAPED);
+        flags.set_if(
+            stage.mode() == TensionLoopMode::Lost,
+            Flags::LOAD_CELL_LOST,
+        );
+        self.events
+            .record(tick, out.mode_changed.map(EventKind::TensionLoop));
+        Shaped {
+            demand: Command {
+                rate_mps: out.rate_mps,
+                accel_mps2: out.accel_mps2,
+            },
+            flags,
+        }
+    }
+
+    /// Limit the (shaped) demand to the envelope and the protection's bounds. The acceleration
     /// limit holds per command: a command differs from the previous one by at most a·Δt,
     /// whatever the calls' pattern (a gap of n ticks does not allow n·a·Δt: the reel ran at the
     /// previous command all along, and would step).
-    fn limit(&mut self, s: &Sensed<T>, reference: &Reference<T>, solved: &Solved<T>) -> Decided<T> {
+    fn limit(
+        &mut self,
+        s: &Sensed<T>,
+        reference: &Reference<T>,
+        solved: &Solved<T>,
+        shaped: &Shaped<T>,
+    ) -> Decided<T> {
         let (l, dt) = (s.input.length_m, self.cfg.period_s);
         let previous = self.last_command.rate_mps;
         let bounds = self.bounds(solved.free_tension.as_ref(), previous);
-        let demand = solved.demand;
+        // With the tension loop, the protection's floor gives way to the attitude as the loop's
+        // window does (docs/equations.md §17.5).
+        let bounds = match &self.tension {
+            Some(t) => t.share_bounds(bounds, previous, dt),
+            None => bounds,
+        };
+        let demand = shaped.demand;
         let (rate_mps, accel_mps2, sat) =
             self.envelope
                 .limit_law(demand.rate_mps, demand.accel_mps2, previous, l, dt, &bounds);
-        let mut flags = Flags(sat.0);
+        let mut flags = Flags(sat.0 | shaped.flags.0);
         flags.set_if(reference.slewing, Flags::SLEWING);
         Decided {
             command: Command {
@@ -695,6 +768,9 @@ impl<T: Real> Controller<T> {
     ) -> Decided<T> {
         let dt = self.cfg.period_s;
         let previous = self.last_command.rate_mps;
+        if let Some(t) = &mut self.tension {
+            t.skipped();
+        }
         let target = match (time_moved, self.health.health()) {
             (false, _) | (true, Health::Degraded) => previous,
             (true, Health::Nominal | Health::SafeHold) => {

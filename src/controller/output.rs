@@ -93,6 +93,11 @@ impl Flags {
     /// The protection's tension bound restricted the command (or its reported acceleration):
     /// the law asked for an acceleration the tether does not carry (docs/equations.md §14).
     pub const TENSION_LIMITED: u32 = Saturation::TENSION;
+    /// The tension loop's window limited the law's rate to an acceleration the tether carries
+    /// (docs/equations.md §17.4).
+    pub const TENSION_SHAPED: u32 = 1 << 11;
+    /// The tension loop flies without its load cell: it was lost (docs/equations.md §17.6).
+    pub const LOAD_CELL_LOST: u32 = 1 << 12;
 
     /// `true` if every bit of `mask` is set.
     pub fn contains(self, mask: u32) -> bool {

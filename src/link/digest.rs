@@ -48,6 +48,7 @@ pub fn config_digest(cfg: &crate::controller::Config<f32>) -> u32 {
         monitor,
         protection,
         rate_source,
+        tension_loop,
     } = cfg;
     let Orbit {
         semi_major_axis_m,
@@ -207,6 +208,36 @@ pub fn config_digest(cfg: &crate::controller::Config<f32>) -> u32 {
         ] {
             h = fnv1a_f32(h, *x);
         }
+    }
+    // The tension loop, when configured (a configuration without one digests as before).
+    if let Some(t) = tension_loop {
+        let crate::controller::TensionLoopConfig {
+            axial_stiffness_n,
+            damping_ratio,
+            washout_s,
+            min_tension_n,
+            max_tension_n,
+            overshoot,
+            fallback_accel_mps2,
+            load_cell_timeout_ticks,
+            yield_from_rad,
+            yield_full_rad,
+        } = t;
+        h = fnv1a(h, &[3]);
+        for x in [
+            axial_stiffness_n,
+            damping_ratio,
+            washout_s,
+            min_tension_n,
+            max_tension_n,
+            overshoot,
+            fallback_accel_mps2,
+            yield_from_rad,
+            yield_full_rad,
+        ] {
+            h = fnv1a_f32(h, *x);
+        }
+        h = fnv1a(h, &load_cell_timeout_ticks.to_le_bytes());
     }
     h
 }

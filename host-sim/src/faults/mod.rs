@@ -24,8 +24,7 @@ pub use report::{
 };
 pub use summary::{
     FaultEvent, FaultEventKind, FaultSummary, FaultTally, FlagTicks, SummaryBuilder, TickRecord,
-    MAX_EVENTS, TUMBLE_ANGLE_RAD,
-};
+    MAX_EVENTS, TUMBLE_ANGLE_RAD, TautSummary};
 
 // ---- what is injected: the fault model's parameters -------------------------------------------
 

@@ -244,6 +244,19 @@ pub fn render_fault_summary(setup: impl Into<FaultSetup>, s: &FaultSummary) -> S
         "  tension: min {:.6} N at {:.0} s; slack (T ≤ 0): {} events, {:.0} s",
         s.min_tension_n.0, s.min_tension_n.1, s.slack_events, s.slack_s
     );
+    let t = &s.taut;
+    match t.from_s {
+        Some(from_s) => {
+            let _ = writeln!(
+                o,
+                "  taut from l = {} m (reached at {from_s:.0} s): slack {} events, {:.0} s; min {:.6} N at {:.0} s",
+                t.from_length_m, t.slack_events, t.slack_s, t.min_tension_n.0, t.min_tension_n.1
+            );
+        }
+        None => {
+            let _ = writeln!(o, "  taut from l = {} m: never reached", t.from_length_m);
+        }
+    }
     if !s.slack_episodes.is_empty() {
         let shown: Vec<String> = s
             .slack_episodes

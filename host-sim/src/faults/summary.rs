@@ -162,6 +162,27 @@ pub struct FaultSummary {
     pub reel_rate_saturated_ticks: u32,
     /// Periods in which the reel drive ran at its own acceleration limit.
     pub reel_accel_saturated_ticks: u32,
+    /// The slack that counts: from the point the tether must be taut on
+    /// (`simulation.taut_from_length_m`, docs/equations.md §17.7).
+    pub taut: TautSummary,
+}
+
+/// Slack from the point the tether must be taut on: the first tick at which the length reached
+/// `from_length_m` (docs/equations.md §17.7). Before it the tensions are millinewtons, below what
+/// the reel's friction lets it regulate; every tick from it on counts.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TautSummary {
+    /// The length from which the tether must be taut, m.
+    pub from_length_m: f64,
+    /// When the length first reached it, s (`None`: never).
+    pub from_s: Option<f64>,
+    /// Times the tension fell to ≤ 0 from then on (a tick already slack at the point counts as
+    /// one).
+    pub slack_events: u32,
+    /// Time with tension ≤ 0 from then on, s.
+    pub slack_s: f64,
+    /// The least tension from then on, N, and when (s) (+∞ before the point is reached).
+    pub min_tension_n: (f64, f64),
 }
 
 /// The |α| at which the tether has tumbled, rad: π/2, the line horizontal (past it the tether
@@ -225,6 +246,8 @@ pub struct SummaryBuilder {
     last_fault: Option<Fault>,
     last_rate_mps: Option<f64>,
     slack: bool,
+    /// The last tick was slack and counted by the taut summary.
+    taut_slack: bool,
 }
 
 impl SummaryBuilder {
@@ -235,6 +258,10 @@ impl SummaryBuilder {
                 period_s,
                 min_tension_n: (f64::INFINITY, 0.0),
                 length_range_m: (f64::INFINITY, f64::NEG_INFINITY),
+                taut: TautSummary {
+                    min_tension_n: (f64::INFINITY, 0.0),
+                    ..TautSummary::default()
+                },
                 ..FaultSummary::default()
             },
             min_length_m: envelope.min_length_m,
@@ -245,7 +272,15 @@ impl SummaryBuilder {
             last_fault: None,
             last_rate_mps: None,
             slack: false,
+            taut_slack: false,
         }
+    }
+
+    /// The tether must be taut from the first tick at which the length reaches `length_m` on
+    /// (default 0: from the start).
+    pub fn taut_from_length(mut self, length_m: f64) -> Self {
+        self.s.taut.from_length_m = length_m;
+        self
     }
 
     /// Records one controller step.
@@ -326,6 +361,22 @@ impl SummaryBuilder {
             }
         }
         self.slack = slack;
+        let taut = &mut s.taut;
+        if taut.from_s.is_none() && r.length_m >= taut.from_length_m {
+            taut.from_s = Some(r.t_s);
+        }
+        if taut.from_s.is_some() {
+            if r.tension_n < taut.min_tension_n.0 {
+                taut.min_tension_n = (r.tension_n, r.t_s);
+            }
+            if slack {
+                taut.slack_s += dt;
+                if !self.taut_slack {
+                    taut.slack_events += 1;
+                }
+            }
+            self.taut_slack = slack;
+        }
         let alpha = r.alpha_rad.abs();
         // NaN counts as the largest.
         if alpha > s.max_abs_alpha_rad.0 || (alpha.is_nan() && !s.max_abs_alpha_rad.0.is_nan()) {

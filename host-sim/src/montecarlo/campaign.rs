@@ -284,12 +284,15 @@ impl Outcome {
         set(Metric::Keep1Error, keep1_error);
         set(Metric::Table1Stage1, table1(1));
         set(Metric::Table1Stage2, table1(2));
+        // Tension and slack from the point the tether must be taut on
+        // (`simulation.taut_from_length_m`; from the start by default).
+        let taut = &f.taut;
         set(
             Metric::MinTension,
-            (f.ticks > 0).then_some(f.min_tension_n.0),
+            taut.from_s.map(|_| taut.min_tension_n.0),
         );
-        set(Metric::SlackEvents, Some(f64::from(f.slack_events)));
-        set(Metric::Slack, Some(f.slack_s));
+        set(Metric::SlackEvents, Some(f64::from(taut.slack_events)));
+        set(Metric::Slack, Some(taut.slack_s));
         set(Metric::FinalLength, final_length);
         set(
             Metric::FinalError,

@@ -109,6 +109,7 @@ impl Scenario {
             protection: sc
                 .protection
                 .to_protection_config(sc.encoder_rate_resolution_mps()),
+            tension_loop: sc.tension_loop.to_tension_loop_config(),
         }
     }
 

@@ -137,6 +137,14 @@ fn message(sc: &Scenario, e: &ConfigError, key: &str, x: f64) -> String {
                 "must be above protection.min_tension_n = {}",
                 num(sc.protection.min_tension_n)
             ),
+            "tension_loop.max_tension_n" => format!(
+                "must be above tension_loop.min_tension_n = {}",
+                num(sc.tension_loop.min_tension_n)
+            ),
+            "tension_loop.yield_full_rad" => format!(
+                "must be above tension_loop.yield_from_rad = {}",
+                num(sc.tension_loop.yield_from_rad)
+            ),
             "stage1.band_start_m" => format!(
                 "must be below stage1.keep_length_m = {}",
                 num(sc.stage1.keep_length_m)
@@ -168,11 +176,17 @@ fn message(sc: &Scenario, e: &ConfigError, key: &str, x: f64) -> String {
             num(sc.masses.main_initial_kg)
         ),
         Rule::NoEquilibrium => "leaves no equilibrium over the whole orbit (Eq. 13)".to_string(),
-        Rule::BelowMinimum if key == "protection.tension_filter_s" => format!(
+        Rule::BelowMinimum if key == "tension_loop.overshoot" => {
+            "must be at least 1 (an allowance for the elastic overshoot)".to_string()
+        }
+        Rule::OutOfRange if key == "tension_loop.damping_ratio" => {
+            "must be at most 2 (a damping ratio of the tether's bounce)".to_string()
+        }
+        Rule::BelowMinimum if key == "protection.tension_filter_s" || key == "tension_loop.washout_s" => format!(
             "must be at least controller.period_s = {} s",
             num(sc.controller.period_s)
         ),
-        Rule::TooLarge if key == "protection.max_tension_n" => format!(
+        Rule::TooLarge if key == "protection.max_tension_n" || key == "tension_loop.max_tension_n" => format!(
             "must be at most {} N (tss_reel::controller::MAX_PLAUSIBLE_TENSION_N)",
             num(tss_reel::controller::MAX_PLAUSIBLE_TENSION_N)
         ),

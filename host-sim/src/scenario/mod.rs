@@ -6,7 +6,7 @@
 //! - one file per group of sections, each holding the section's schema (a serde struct, its
 //!   defaults) and its validation rules next to it: `system.rs` (`[orbit]`, `[masses]`,
 //!   `[tether]`), `initial.rs`, `control.rs` (`[controller]`, `[stage1]`, `[stage2]`),
-//!   `envelope.rs`, `monitor.rs`, `protection.rs`, `simulation.rs`, `sensors.rs` (`[sensors]`, `[faults]`),
+//!   `envelope.rs`, `monitor.rs`, `protection.rs`, `tension_loop.rs`, `simulation.rs`, `sensors.rs` (`[sensors]`, `[faults]`),
 //!   `reel.rs`, `link.rs`, `montecarlo.rs`, `plant.rs` (`[plant]`), `environment.rs`;
 //! - `core_rules.rs`: the flight controller's own rules, not repeated here: the f32 controller
 //!   is built from the scenario and the parameter path of what it rejects is named by scenario
@@ -59,6 +59,7 @@ mod schema;
 mod sensors;
 mod simulation;
 mod system;
+mod tension_loop;
 
 #[cfg(test)]
 mod tests;
@@ -99,6 +100,7 @@ pub use system::{
     MassesSection, OrbitSection, TetherSection, EARTH_EQUATORIAL_RADIUS_M, EARTH_HILL_RADIUS_M,
     MIN_PERIGEE_ALTITUDE_M,
 };
+pub use tension_loop::TensionLoopSection;
 
 use rules::Validator;
 
@@ -152,6 +154,10 @@ pub struct Scenario {
     /// controller).
     #[serde(default)]
     pub protection: ProtectionSection,
+    /// The controller's tension loop (docs/equations.md §17; default: off, the paper's
+    /// controller).
+    #[serde(default)]
+    pub tension_loop: TensionLoopSection,
     /// Faults of the processor-in-the-loop serial link (`tss-sim run --pil`; default: none).
     /// A host-linked run has no link and ignores it.
     #[serde(default)]
@@ -234,6 +240,15 @@ impl Scenario {
             "environment.drag",
             "true".to_string(),
             needs,
+        );
+        // The loop's gain is scheduled on the tether's compliance (EA): on a rod infinitely
+        // stiffer than it is told it is unstable (docs/equations.md §17.3).
+        v.check(
+            !self.tension_loop.enabled,
+            "tension_loop.enabled",
+            "true".to_string(),
+            "needs plant.model = \"elastic\" (the loop damps an elastic tether's bounce; on the \
+             rigid rod, infinitely stiff, it is unstable: docs/equations.md §17.3)",
         );
     }
 

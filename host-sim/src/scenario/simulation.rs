@@ -35,6 +35,12 @@ pub struct SimulationSection {
     /// Interval between rows of history.csv, s (a multiple of the control period).
     #[serde(default = "ten_s")]
     pub output_interval_s: f64,
+    /// The tether must be taut from the first tick at which the paid-out length reaches this,
+    /// m (docs/equations.md §17.7): slack before it is reported, slack after it is what the run
+    /// summary's "after the taut point" figures and the Monte Carlo `no_slack` criterion count.
+    /// 0 (the default): from the start.
+    #[serde(default)]
+    pub taut_from_length_m: f64,
 }
 
 fn one() -> u32 {
@@ -94,6 +100,7 @@ impl SimulationSection {
                 ),
             );
         }
+        v.non_negative("simulation.taut_from_length_m", sim.taut_from_length_m);
         if v.positive("simulation.output_interval_s", sim.output_interval_s) {
             v.whole_multiple_of_period(
                 "simulation.output_interval_s",

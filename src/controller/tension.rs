@@ -1,0 +1,434 @@
+//! The tension loop's stage in the step (docs/equations.md §17): between the law and the
+//! envelope, it shapes the law's rate by the tension the tether carries (17.8) and adds the
+//! admittance term that damps the tether's bounce (17.3), from the load cell at the reel.
+//!
+//! ```text
+//!   u = clamp(u_law, u_s,prev + a_lo Δt, u_s,prev + a_hi Δt) + K(l)·HP[T_meas + m_r a_s]
+//! ```
+//!
+//! u_s,prev is the last command sent less its admittance part (so the envelope's own limits are
+//! seen: no wind-up); the window [a_lo, a_hi] comes from the washout's mean free tension and is
+//! widened to the envelope's as the attitude error grows (§17.5). Without a load cell the
+//! admittance term is 0 and the window is the configured fallback (§17.6).
+
+use crate::config::TensionLoopConfig;
+use crate::mass::MassModel;
+use crate::real::Real;
+use crate::tension::{
+    admittance_gain_mps_per_n, attitude_share, tension_window_mps2, washout_weight, Washout,
+};
+
+use crate::config::MAX_PLAUSIBLE_TENSION_N;
+use crate::envelope::Bounds;
+
+/// What the tension loop flies on (docs/equations.md §17.6).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum TensionLoopMode {
+    /// No load-cell sample yet: no admittance term, the fallback window.
+    Waiting,
+    /// The load cell is read: admittance term and tension window.
+    Tracking,
+    /// A few periods without a load-cell sample: no admittance term, the last mean tension's
+    /// window.
+    Coasting,
+    /// The load cell is lost (more than `load_cell_timeout_ticks` periods without a sample): no
+    /// admittance term, the fallback window, until the next sample.
+    Lost,
+}
+
+/// The load cell as the loop knows it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum LoadCell<T> {
+    /// No sample yet.
+    Waiting,
+    /// Read at the last step; the washout's mean.
+    Tracking(Washout<T>),
+    /// `missing` periods without a sample since the last one; the washout as it was then.
+    Coasting { washout: Washout<T>, missing: u32 },
+    /// Lost.
+    Lost,
+}
+
+impl<T> LoadCell<T> {
+    fn mode(&self) -> TensionLoopMode {
+        match self {
+            LoadCell::Waiting => TensionLoopMode::Waiting,
+            LoadCell::Tracking(_) => TensionLoopMode::Tracking,
+            LoadCell::Coasting { .. } => TensionLoopMode::Coasting,
+            LoadCell::Lost => TensionLoopMode::Lost,
+        }
+    }
+}
+
+/// What the stage needs from the step.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct StageInput<T> {
+    /// The law's rate (Eqs. 27, 29), m/s.
+    pub(crate) law_rate_mps: T,
+    /// Its acceleration (Eq. 30), m/s².
+    pub(crate) law_accel_mps2: T,
+    /// The last command sent, m/s.
+    pub(crate) previous_mps: T,
+    /// l, m.
+    pub(crate) length_m: T,
+    /// δ, the law's attitude error, rad.
+    pub(crate) delta_rad: T,
+    /// The load cell's sample of this step, N.
+    pub(crate) tension_n: Option<T>,
+}
+
+/// What the stage decided.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct StageOutput<T> {
+    /// The command requested of the envelope, m/s.
+    pub(crate) rate_mps: T,
+    /// Its acceleration, m/s²: the law's (Eq. 30) plus the admittance term's change over the
+    /// period; the shaped ramp's slope when the window limited the law.
+    pub(crate) accel_mps2: T,
+    /// The window limited the law's rate.
+    pub(crate) shaped: bool,
+    /// The mode changed at this step (an event).
+    pub(crate) mode_changed: Option<TensionLoopMode>,
+}
+
+/// The tension loop's state.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TensionStage<T> {
+    cfg: TensionLoopConfig<T>,
+    masses: MassModel<T>,
+    /// m_r and 1/m_r at zero length (those of every length for a massless tether), kg and 1/kg.
+    radial_kg: T,
+    inv_radial_per_kg: T,
+    /// β of the washout (17.3).
+    washout_weight: T,
+    /// The envelope's acceleration limit, m/s² (the window's width at full attitude share).
+    envelope_accel_mps2: T,
+    /// Control period, s.
+    period_s: T,
+    load_cell: LoadCell<T>,
+    /// The admittance part of the last command sent, m/s (0 after a step the stage did not
+    /// decide: a safe action).
+    last_admittance_mps: T,
+    /// a_s, the shaped rate's change over the last period, m/s² (the acceleration the reel was
+    /// asked for deliberately: its tension is added back to the load cell's, 17.3).
+    last_shaped_accel_mps2: T,
+    /// The attitude's share of the authority at the last step (§17.5).
+    attitude_share: T,
+}
+
+impl<T: Real> TensionStage<T> {
+    /// The stage of a validated configuration.
+    pub(crate) fn new(
+        cfg: TensionLoopConfig<T>,
+        masses: MassModel<T>,
+        period_s: T,
+        envelope_accel_mps2: T,
+    ) -> Self {
+        let radial_kg = masses.coefficients(T::ZERO).radial_kg;
+        Self {
+            cfg,
+            masses,
+            radial_kg,
+            inv_radial_per_kg: T::ONE / radial_kg,
+            washout_weight: washout_weight(cfg.washout_s, period_s),
+            envelope_accel_mps2,
+            period_s,
+            load_cell: LoadCell::Waiting,
+            last_admittance_mps: T::ZERO,
+            last_shaped_accel_mps2: T::ZERO,
+            attitude_share: T::ZERO,
+        }
+    }
+
+    /// The protection's tension bounds (docs/equations.md §14) widened by the attitude's share
+    /// of this step (§17.5): at a share of 1 the protection's floor no longer holds the reel
+    /// against the law (O-11), the envelope's acceleration limit `envelope_accel_mps2` is what
+    /// is left. `previous_mps` is the last command, `dt_s` the period.
+    pub(crate) fn share_bounds(&self, mut b: Bounds<T>, previous_mps: T, dt_s: T) -> Bounds<T> {
+        let w = self.attitude_share;
+        if w <= T::ZERO {
+            return b;
+        }
+        let a = self.envelope_accel_mps2;
+        let widen = |lo: T, hi: T, lo_end: T, hi_end: T| {
+            (
+                lo - w * (lo - lo_end).max(T::ZERO),
+                hi + w * (hi_end - hi).max(T::ZERO),
+            )
+        };
+        b.tension_rate_mps = b.tension_rate_mps.map(|(lo, hi)| {
+            widen(lo, hi, previous_mps - a * dt_s, previous_mps + a * dt_s)
+        });
+        b.tension_accel_mps2 = b.tension_accel_mps2.map(|(lo, hi)| widen(lo, hi, -a, a));
+        b
+    }
+
+    /// The loop's mode after the last step.
+    pub(crate) fn mode(&self) -> TensionLoopMode {
+        self.load_cell.mode()
+    }
+
+    /// A step in which the law did not run (a safe action): the command sent is not the stage's,
+    /// so the next step shapes from it as it is.
+    pub(crate) fn skipped(&mut self) {
+        self.last_admittance_mps = T::ZERO;
+        self.last_shaped_accel_mps2 = T::ZERO;
+    }
+
+    /// One step of the law: the command to request of the envelope.
+    pub(crate) fn step(&mut self, x: &StageInput<T>) -> StageOutput<T> {
+        let dt = self.period_s;
+        let (radial_kg, inv_radial_per_kg) =
+            if self.masses.tether_density_kg_per_m == T::ZERO {
+                (self.radial_kg, self.inv_radial_per_kg)
+            } else {
+                let m = self.masses.coefficients(x.length_m).radial_kg;
+                (m, T::ONE / m)
+            };
+        let before = self.load_cell.mode();
+
+        // The load cell: the free tension it measures (17.3), its mean and its bounce.
+        let plausible = T::from_f64(MAX_PLAUSIBLE_TENSION_N);
+        let sample = x
+            .tension_n
+            .filter(|t| t.is_finite() && t.abs() <= plausible);
+        let bounce_n = match (sample, &mut self.load_cell) {
+            (Some(t), LoadCell::Tracking(w) | LoadCell::Coasting { washout: w, .. }) => {
+                let mut w = *w;
+                let free_n = t + radial_kg * self.last_shaped_accel_mps2;
+                let hp = w.update(free_n, self.washout_weight);
+                self.load_cell = LoadCell::Tracking(w);
+                hp
+            }
+            (Some(t), LoadCell::Waiting | LoadCell::Lost) => {
+                let free_n = t + radial_kg * self.last_shaped_accel_mps2;
+                self.load_cell = LoadCell::Tracking(Washout::starting_at(free_n));
+                T::ZERO
+            }
+            (None, LoadCell::Tracking(w)) => {
+                self.load_cell = LoadCell::Coasting {
+                    washout: *w,
+                    missing: 1,
+                };
+                T::ZERO
+            }
+            (None, LoadCell::Coasting { washout, missing }) => {
+                self.load_cell = if *missing >= self.cfg.load_cell_timeout_ticks {
+                    LoadCell::Lost
+                } else {
+                    LoadCell::Coasting {
+                        washout: *washout,
+                        missing: *missing + 1,
+                    }
+                };
+                T::ZERO
+            }
+            (None, LoadCell::Waiting | LoadCell::Lost) => T::ZERO,
+        };
+
+        // The window (17.8), widened by the attitude's share (§17.5).
+        let c = &self.cfg;
+        let (a_lo, a_hi) = match &self.load_cell {
+            // Judged on the mean and on this period's free tension, whichever is the worse for
+            // the motion (the mean lags a free tension that changes, as in the slew).
+            LoadCell::Tracking(w) | LoadCell::Coasting { washout: w, .. } => tension_window_mps2(
+                w.mean_n + bounce_n.min(T::ZERO),
+                w.mean_n + bounce_n.max(T::ZERO),
+                c.min_tension_n,
+                c.max_tension_n,
+                c.overshoot,
+                inv_radial_per_kg,
+            ),
+            LoadCell::Waiting | LoadCell::Lost => (-c.fallback_accel_mps2, c.fallback_accel_mps2),
+        };
+        let share = attitude_share(x.delta_rad, c.yield_from_rad, c.yield_full_rad);
+        self.attitude_share = share;
+        let a_env = self.envelope_accel_mps2;
+        let a_hi = a_hi + share * (a_env - a_hi).max(T::ZERO);
+        let a_lo = a_lo - share * (a_env + a_lo).max(T::ZERO);
+
+        // The shaped law (17.8), from the last command less its admittance part.
+        let anchor_mps = x.previous_mps - self.last_admittance_mps;
+        let (lo, hi) = (anchor_mps + a_lo * dt, anchor_mps + a_hi * dt);
+        let shaped_mps = x.law_rate_mps.clamp_to(lo, hi);
+        let shaped = shaped_mps != x.law_rate_mps;
+        self.last_shaped_accel_mps2 = (shaped_mps - anchor_mps) / dt;
+
+        // The admittance term (17.3), K(l) of (17.5)–(17.6).
+        let gain = admittance_gain_mps_per_n(
+            x.length_m,
+            c.axial_stiffness_n,
+            radial_kg,
+            c.damping_ratio,
+            dt,
+        );
+        let admittance_mps = gain * bounce_n;
+        let rate_mps = shaped_mps + admittance_mps;
+        let accel_mps2 = if shaped {
+            (rate_mps - x.previous_mps) / dt
+        } else {
+            x.law_accel_mps2 + (admittance_mps - self.last_admittance_mps) / dt
+        };
+        self.last_admittance_mps = admittance_mps;
+
+        let after = self.load_cell.mode();
+        StageOutput {
+            rate_mps,
+            accel_mps2,
+            shaped,
+            mode_changed: (after != before).then_some(after),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn stage() -> TensionStage<f64> {
+        TensionStage::new(
+            TensionLoopConfig::dyneema_half_mm(),
+            MassModel::paper(),
+            1.0,
+            15.0,
+        )
+    }
+
+    fn input(law_rate_mps: f64, previous_mps: f64, tension_n: Option<f64>) -> StageInput<f64> {
+        StageInput {
+            law_rate_mps,
+            law_accel_mps2: 0.0,
+            previous_mps,
+            length_m: 2_000.0,
+            delta_rad: 0.0,
+            tension_n,
+        }
+    }
+
+    /// A steady load cell leaves the law's rate as it is: the washout's mean is the tension,
+    /// nothing is high-passed, and a law inside the window is not shaped.
+    #[test]
+    fn a_steady_tether_leaves_the_law_alone() {
+        let mut s = stage();
+        let mut previous = -0.001;
+        for _ in 0..10 {
+            let out = s.step(&input(-0.001, previous, Some(0.67)));
+            assert!((out.rate_mps - -0.001).abs() < 1e-12, "{out:?}");
+            assert!(!out.shaped);
+            previous = out.rate_mps;
+        }
+        assert_eq!(s.mode(), TensionLoopMode::Tracking);
+    }
+
+    /// A tension above the mean pays out (K > 0) by K(l) times the high-passed part.
+    #[test]
+    fn a_pull_pays_out_by_the_scheduled_gain() {
+        let mut s = stage();
+        let _ = s.step(&input(0.0, 0.0, Some(0.67)));
+        let out = s.step(&input(0.0, 0.0, Some(1.67)));
+        let m_r = MassModel::<f64>::paper().coefficients(0.0).radial_kg;
+        let gain = admittance_gain_mps_per_n(2_000.0, 1e4, m_r, 0.6, 1.0);
+        let beta = washout_weight(100.0, 1.0);
+        // The two-sample mean: half the step, high-passed.
+        let hp = 0.5 * (1.0 - beta);
+        assert!((out.rate_mps - gain * hp).abs() < 1e-12, "{out:?}");
+    }
+
+    /// The slew's −125 m/s is shaped to what the tension carries: the wind-in starts at a_lo and
+    /// the braking afterwards is limited to a_hi.
+    #[test]
+    fn a_rate_step_is_shaped_to_the_tension_window() {
+        let mut s = stage();
+        let m_r = MassModel::<f64>::paper().coefficients(0.0).radial_kg;
+        let t = 7.5;
+        let _ = s.step(&input(0.0, 0.0, Some(t)));
+        let out = s.step(&input(-125.0, 0.0, Some(t)));
+        assert!(out.shaped);
+        let a_lo = -(18.0 - t) / (1.5 * m_r);
+        assert!((out.rate_mps - a_lo).abs() < 1e-9, "{out:?}");
+        // The braking from −5 m/s toward 0: at most a_hi per period (the mean free tension is
+        // the load cell's plus m_r a_s: the tension the braking takes away is added back).
+        let mut s = stage();
+        let _ = s.step(&input(-5.0, -5.0, Some(t)));
+        let out = s.step(&input(0.0, -5.0, Some(t)));
+        let a_hi = (t - 0.1) / (1.5 * m_r);
+        assert!((out.rate_mps - (-5.0 + a_hi)).abs() < 1e-9, "{out:?}");
+    }
+
+    /// A tumbling attitude takes the authority: at |δ| ≥ yield_full_rad the window is the
+    /// envelope's.
+    #[test]
+    fn the_window_gives_way_to_the_attitude() {
+        let mut s = stage();
+        let _ = s.step(&input(0.0, 0.0, Some(0.2)));
+        let x = StageInput {
+            delta_rad: 0.6,
+            ..input(2.0, 0.0, Some(0.2))
+        };
+        let out = s.step(&x);
+        assert!(!out.shaped);
+        assert!((out.rate_mps - 2.0).abs() < 1e-3, "{out:?}");
+    }
+
+    /// The load cell fails: it coasts on the last mean for the timeout, then it is lost (the
+    /// fallback window, no admittance term); a sample restarts it without a bump.
+    #[test]
+    fn a_failed_load_cell_coasts_then_is_lost_and_a_sample_restarts_it() {
+        let mut s = stage();
+        assert_eq!(s.mode(), TensionLoopMode::Waiting);
+        // Waiting: the fallback window.
+        let out = s.step(&input(1.0, 0.0, None));
+        assert!((out.rate_mps - 4.5e-3).abs() < 1e-12);
+        assert_eq!(out.mode_changed, None);
+        let out = s.step(&input(0.0, 0.0, Some(3.0)));
+        assert_eq!(out.mode_changed, Some(TensionLoopMode::Tracking));
+        assert_eq!(out.rate_mps, 0.0);
+        let mut modes = [TensionLoopMode::Waiting; 7];
+        let bad = [None, Some(f64::NAN), Some(f64::INFINITY), Some(-2e5), None, None, None];
+        for (k, t) in bad.into_iter().enumerate() {
+            let out = s.step(&input(0.0, 0.0, t));
+            assert_eq!(out.rate_mps, 0.0, "no admittance term without a sample");
+            modes[k] = s.mode();
+        }
+        use TensionLoopMode::{Coasting, Lost};
+        assert_eq!(modes, [Coasting, Coasting, Coasting, Coasting, Coasting, Lost, Lost]);
+        // Lost: the fallback window.
+        let out = s.step(&input(1.0, 0.0, None));
+        assert!((out.rate_mps - 4.5e-3).abs() < 1e-12);
+        // Back: tracking from that sample, no bump.
+        let out = s.step(&input(0.0, 0.0, Some(9.0)));
+        assert_eq!(out.mode_changed, Some(TensionLoopMode::Tracking));
+        assert_eq!(out.rate_mps, 0.0);
+    }
+
+    /// Every special value in the load cell, the law's rate and δ: a finite command within the
+    /// window of the last one, whenever the law's rate is finite.
+    #[test]
+    fn bad_samples_never_make_a_bad_command() {
+        let specials = [
+            None,
+            Some(f64::NAN),
+            Some(f64::INFINITY),
+            Some(f64::NEG_INFINITY),
+            Some(f64::MAX),
+            Some(-f64::MAX),
+            Some(0.0),
+            Some(-1.0),
+            Some(3.0),
+            Some(1e4),
+        ];
+        let mut s = stage();
+        let mut previous = 0.0;
+        for k in 0..400 {
+            let law = if k % 3 == 0 { 10.0 } else { -10.0 };
+            let x = StageInput {
+                delta_rad: [0.0, 0.3, 1.0, f64::NAN][k % 4],
+                ..input(law, previous, specials[k % specials.len()])
+            };
+            let out = s.step(&x);
+            assert!(out.rate_mps.is_finite(), "{k}: {out:?}");
+            previous = out.rate_mps;
+        }
+    }
+}
