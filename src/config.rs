@@ -257,10 +257,7 @@ impl<T: Real> TensionLoopConfig<T> {
                 Rule::BelowMinimum,
             ));
         }
-        positive(
-            "tension_loop.fallback_accel_mps2",
-            self.fallback_accel_mps2,
-        )?;
+        positive("tension_loop.fallback_accel_mps2", self.fallback_accel_mps2)?;
         positive(
             "tension_loop.load_cell_timeout_ticks",
             T::from_u32(self.load_cell_timeout_ticks),

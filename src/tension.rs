@@ -137,7 +137,13 @@ mod tests {
     /// the admittance term (17.3) of the load cell's sample at the start of the period, told a
     /// tether of stiffness `told_n`. From a 1-N tension disturbance (the tether stretched by
     /// 1 N/k at rest), the largest |tension deviation| over each of `windows` bounce periods.
-    fn bounce_envelope(length_m: f64, stiffness_n: f64, told_n: f64, lag_s: f64, windows: usize) -> Vec<f64> {
+    fn bounce_envelope(
+        length_m: f64,
+        stiffness_n: f64,
+        told_n: f64,
+        lag_s: f64,
+        windows: usize,
+    ) -> Vec<f64> {
         let (k, c) = (stiffness_n / length_m, 1000.0 / length_m);
         let gain = admittance_gain_mps_per_n(length_m, told_n, M, 0.6, 1.0);
         let beta = washout_weight(100.0, 1.0);
@@ -181,7 +187,10 @@ mod tests {
         // Short: the bounce (1.4 rad/s at 50 m) is faster than a 1-s command damps; K ∝ l.
         for l in [10.0, 50.0] {
             let gain = admittance_gain_mps_per_n(l, EA, M, 0.6, 1.0);
-            assert!((gain * EA / l - MAX_GAIN_PERIOD_PRODUCT).abs() < 1e-12, "{l}");
+            assert!(
+                (gain * EA / l - MAX_GAIN_PERIOD_PRODUCT).abs() < 1e-12,
+                "{l}"
+            );
         }
         // Where the cap takes over: ζ_d √(l/(EA m)) = g l/EA … l = EA (2ζ/g)²/m ≈ 58 m.
         let corner = EA * (2.0 * 0.6 / MAX_GAIN_PERIOD_PRODUCT).powi(2) / M;
@@ -202,7 +211,10 @@ mod tests {
         for l in [300.0, 1_000.0, 2_000.0, 10_000.0, 30_000.0] {
             for ratio in [0.5, 1.0, 1.5] {
                 let peaks = bounce_envelope(l, ratio * EA, EA, 0.2, 6);
-                assert!(peaks[5] < 0.2 * peaks[0], "l = {l}, EA × {ratio}: {peaks:?}");
+                assert!(
+                    peaks[5] < 0.2 * peaks[0],
+                    "l = {l}, EA × {ratio}: {peaks:?}"
+                );
             }
         }
         // At 50 and 100 m the bounce (1.0–1.7 rad/s) nears the period's Nyquist rate: the capped
@@ -210,7 +222,10 @@ mod tests {
         for l in [50.0, 100.0] {
             for ratio in [0.5, 1.0, 1.5] {
                 let peaks = bounce_envelope(l, ratio * EA, EA, 0.2, 6);
-                assert!(peaks.iter().all(|&p| p <= peaks[0]), "{l}, EA × {ratio}: {peaks:?}");
+                assert!(
+                    peaks.iter().all(|&p| p <= peaks[0]),
+                    "{l}, EA × {ratio}: {peaks:?}"
+                );
             }
         }
     }

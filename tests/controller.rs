@@ -104,17 +104,58 @@ fn every_invalid_tension_loop_parameter_is_named() {
         }
     };
     assert!(Controller::new(Config::<f32>::flight()).is_ok());
-    let cases: [(&dyn Fn(&mut TensionLoopConfig<f32>), &str, Rule); 10] = [
-        (&|t| t.axial_stiffness_n = 0.0, "tension_loop.axial_stiffness_n", Rule::NotPositive),
-        (&|t| t.damping_ratio = f32::NAN, "tension_loop.damping_ratio", Rule::NotFinite),
-        (&|t| t.damping_ratio = 3.0, "tension_loop.damping_ratio", Rule::OutOfRange),
-        (&|t| t.washout_s = 0.5, "tension_loop.washout_s", Rule::BelowMinimum),
-        (&|t| t.min_tension_n = -0.1, "tension_loop.min_tension_n", Rule::Negative),
-        (&|t| t.max_tension_n = 0.05, "tension_loop.max_tension_n", Rule::BandInverted),
-        (&|t| t.overshoot = 0.9, "tension_loop.overshoot", Rule::BelowMinimum),
-        (&|t| t.fallback_accel_mps2 = 0.0, "tension_loop.fallback_accel_mps2", Rule::NotPositive),
-        (&|t| t.load_cell_timeout_ticks = 0, "tension_loop.load_cell_timeout_ticks", Rule::NotPositive),
-        (&|t| t.yield_full_rad = 0.1, "tension_loop.yield_full_rad", Rule::BandInverted),
+    type Edit = dyn Fn(&mut TensionLoopConfig<f32>);
+    let cases: [(&Edit, &str, Rule); 10] = [
+        (
+            &|t| t.axial_stiffness_n = 0.0,
+            "tension_loop.axial_stiffness_n",
+            Rule::NotPositive,
+        ),
+        (
+            &|t| t.damping_ratio = f32::NAN,
+            "tension_loop.damping_ratio",
+            Rule::NotFinite,
+        ),
+        (
+            &|t| t.damping_ratio = 3.0,
+            "tension_loop.damping_ratio",
+            Rule::OutOfRange,
+        ),
+        (
+            &|t| t.washout_s = 0.5,
+            "tension_loop.washout_s",
+            Rule::BelowMinimum,
+        ),
+        (
+            &|t| t.min_tension_n = -0.1,
+            "tension_loop.min_tension_n",
+            Rule::Negative,
+        ),
+        (
+            &|t| t.max_tension_n = 0.05,
+            "tension_loop.max_tension_n",
+            Rule::BandInverted,
+        ),
+        (
+            &|t| t.overshoot = 0.9,
+            "tension_loop.overshoot",
+            Rule::BelowMinimum,
+        ),
+        (
+            &|t| t.fallback_accel_mps2 = 0.0,
+            "tension_loop.fallback_accel_mps2",
+            Rule::NotPositive,
+        ),
+        (
+            &|t| t.load_cell_timeout_ticks = 0,
+            "tension_loop.load_cell_timeout_ticks",
+            Rule::NotPositive,
+        ),
+        (
+            &|t| t.yield_full_rad = 0.1,
+            "tension_loop.yield_full_rad",
+            Rule::BandInverted,
+        ),
     ];
     for (f, param, rule) in cases {
         assert_eq!(rejected(with(f)), (param, rule));

@@ -56,7 +56,11 @@ pub struct CompareArgs {
     pub scenario: PathBuf,
     /// The laws to fly, comma-separated: paper (without the tension loop), paper+loop (with
     /// the scenario's `[tension_loop]`), rupp, tracking.
-    #[arg(long, value_delimiter = ',', default_value = "paper,paper+loop,rupp,tracking")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "paper,paper+loop,rupp,tracking"
+    )]
     pub laws: Vec<String>,
     /// Fly each law on this many runs of the scenario's `[montecarlo]` campaign (same seeds for
     /// every law) besides the nominal run.

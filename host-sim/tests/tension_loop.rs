@@ -82,7 +82,10 @@ fn the_stage_2_slew_is_shaped_within_the_motors_torque() {
     let h = fly(&sc);
     let stage2 = || h.samples.iter().filter(|s| s.t_s >= sc.stage2.start_time_s);
     let peak = stage2().map(|s| s.tension_n).fold(0.0, f64::max);
-    assert!(peak < 0.8 * motor_n, "peak {peak} N against the motor's {motor_n} N");
+    assert!(
+        peak < 0.8 * motor_n,
+        "peak {peak} N against the motor's {motor_n} N"
+    );
     assert!(stage2().all(|s| s.tension_n > 0.0));
     // Back-driven: the drum paying out while the command winds in by more than the speed
     // loop's lag can explain (1 m/s).
@@ -90,7 +93,9 @@ fn the_stage_2_slew_is_shaped_within_the_motors_torque() {
         .samples
         .iter()
         .zip(&h.elastic)
-        .filter(|(s, e)| s.t_s >= sc.stage2.start_time_s && e.reel_rate_mps > s.length_rate_mps + 1.0)
+        .filter(|(s, e)| {
+            s.t_s >= sc.stage2.start_time_s && e.reel_rate_mps > s.length_rate_mps + 1.0
+        })
         .count();
     assert_eq!(back_driven, 0);
     // Without the loop the slew's end snaps above the motor's torque.
@@ -128,7 +133,11 @@ fn a_lost_load_cell_degrades_the_loop_and_the_mission_goes_on() {
         .map(|s| s.t_s)
         .expect("the load cell is declared lost");
     assert!((20_000.0..20_020.0).contains(&first_lost), "{first_lost}");
-    assert!(h.samples.iter().filter(|s| s.t_s >= 20_010.0).all(|s| s.flags & lost != 0));
+    assert!(h
+        .samples
+        .iter()
+        .filter(|s| s.t_s >= 20_010.0)
+        .all(|s| s.flags & lost != 0));
     assert_eq!(h.faults.safe_hold_s, 0.0);
     let last = h.samples.last().unwrap();
     assert!((last.length_m - 2_000.0).abs() < 5.0, "{}", last.length_m);

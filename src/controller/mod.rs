@@ -299,12 +299,7 @@ impl<T: Real> Controller<T> {
             monitor: Monitor::new(spool_m, estimation.is_none())?,
             estimation,
             tension: cfg.tension_loop.map(|t| {
-                TensionStage::new(
-                    t,
-                    cfg.masses,
-                    cfg.period_s,
-                    cfg.envelope.max_accel_mps2,
-                )
+                TensionStage::new(t, cfg.masses, cfg.period_s, cfg.envelope.max_accel_mps2)
             }),
             reported: Reported {
                 health: Health::Nominal,
@@ -658,10 +653,7 @@ impl<T: Real> Controller<T> {
             tension_n: s.input.tension_n,
         });
         flags.set_if(out.shaped, Flags::TENSION_SHAPED);
-        flags.set_if(
-            stage.mode() == TensionLoopMode::Lost,
-            Flags::LOAD_CELL_LOST,
-        );
+        flags.set_if(stage.mode() == TensionLoopMode::Lost, Flags::LOAD_CELL_LOST);
         self.events
             .record(tick, out.mode_changed.map(EventKind::TensionLoop));
         Shaped {

@@ -157,9 +157,9 @@ impl<T: Real> TensionStage<T> {
                 hi + w * (hi_end - hi).max(T::ZERO),
             )
         };
-        b.tension_rate_mps = b.tension_rate_mps.map(|(lo, hi)| {
-            widen(lo, hi, previous_mps - a * dt_s, previous_mps + a * dt_s)
-        });
+        b.tension_rate_mps = b
+            .tension_rate_mps
+            .map(|(lo, hi)| widen(lo, hi, previous_mps - a * dt_s, previous_mps + a * dt_s));
         b.tension_accel_mps2 = b.tension_accel_mps2.map(|(lo, hi)| widen(lo, hi, -a, a));
         b
     }
@@ -179,13 +179,12 @@ impl<T: Real> TensionStage<T> {
     /// One step of the law: the command to request of the envelope.
     pub(crate) fn step(&mut self, x: &StageInput<T>) -> StageOutput<T> {
         let dt = self.period_s;
-        let (radial_kg, inv_radial_per_kg) =
-            if self.masses.tether_density_kg_per_m == T::ZERO {
-                (self.radial_kg, self.inv_radial_per_kg)
-            } else {
-                let m = self.masses.coefficients(x.length_m).radial_kg;
-                (m, T::ONE / m)
-            };
+        let (radial_kg, inv_radial_per_kg) = if self.masses.tether_density_kg_per_m == T::ZERO {
+            (self.radial_kg, self.inv_radial_per_kg)
+        } else {
+            let m = self.masses.coefficients(x.length_m).radial_kg;
+            (m, T::ONE / m)
+        };
         let before = self.load_cell.mode();
 
         // The load cell: the free tension it measures (17.3), its mean and its bounce.
@@ -385,14 +384,25 @@ mod tests {
         assert_eq!(out.mode_changed, Some(TensionLoopMode::Tracking));
         assert_eq!(out.rate_mps, 0.0);
         let mut modes = [TensionLoopMode::Waiting; 7];
-        let bad = [None, Some(f64::NAN), Some(f64::INFINITY), Some(-2e5), None, None, None];
+        let bad = [
+            None,
+            Some(f64::NAN),
+            Some(f64::INFINITY),
+            Some(-2e5),
+            None,
+            None,
+            None,
+        ];
         for (k, t) in bad.into_iter().enumerate() {
             let out = s.step(&input(0.0, 0.0, t));
             assert_eq!(out.rate_mps, 0.0, "no admittance term without a sample");
             modes[k] = s.mode();
         }
         use TensionLoopMode::{Coasting, Lost};
-        assert_eq!(modes, [Coasting, Coasting, Coasting, Coasting, Coasting, Lost, Lost]);
+        assert_eq!(
+            modes,
+            [Coasting, Coasting, Coasting, Coasting, Coasting, Lost, Lost]
+        );
         // Lost: the fallback window.
         let out = s.step(&input(1.0, 0.0, None));
         assert!((out.rate_mps - 4.5e-3).abs() < 1e-12);

@@ -182,14 +182,22 @@ fn message(sc: &Scenario, e: &ConfigError, key: &str, x: f64) -> String {
         Rule::OutOfRange if key == "tension_loop.damping_ratio" => {
             "must be at most 2 (a damping ratio of the tether's bounce)".to_string()
         }
-        Rule::BelowMinimum if key == "protection.tension_filter_s" || key == "tension_loop.washout_s" => format!(
-            "must be at least controller.period_s = {} s",
-            num(sc.controller.period_s)
-        ),
-        Rule::TooLarge if key == "protection.max_tension_n" || key == "tension_loop.max_tension_n" => format!(
-            "must be at most {} N (tss_reel::controller::MAX_PLAUSIBLE_TENSION_N)",
-            num(tss_reel::controller::MAX_PLAUSIBLE_TENSION_N)
-        ),
+        Rule::BelowMinimum
+            if key == "protection.tension_filter_s" || key == "tension_loop.washout_s" =>
+        {
+            format!(
+                "must be at least controller.period_s = {} s",
+                num(sc.controller.period_s)
+            )
+        }
+        Rule::TooLarge
+            if key == "protection.max_tension_n" || key == "tension_loop.max_tension_n" =>
+        {
+            format!(
+                "must be at most {} N (tss_reel::controller::MAX_PLAUSIBLE_TENSION_N)",
+                num(tss_reel::controller::MAX_PLAUSIBLE_TENSION_N)
+            )
+        }
         Rule::BelowMinimum => format!(
             "must be at least {} s (tss_reel::config::MIN_PERIOD_S)",
             num(tss_reel::config::MIN_PERIOD_S)
