@@ -199,9 +199,10 @@ pub struct TensionLoopConfig<T> {
 impl<T: Real> TensionLoopConfig<T> {
     /// The loop for the 0.5 mm Dyneema of `scenarios/paper-elastic.toml` (EA = 10 kN) on the
     /// paper's masses (docs/equations.md §17): ζ_d = 0.6, τ_w = 100 s, the mean tension kept in
-    /// [0.1 N, 15 N] (the drum's motor holds 20 N at the tether) with κ = 1.5, a fallback of
-    /// 4.5e-3 m/s² (the 2-km keep's 0.67 N on 99 kg at κ = 1.5), the load cell lost after 5
-    /// periods without a sample, the attitude's share from |δ| = 0.2 rad to 0.5 rad.
+    /// [0.1 N, 18 N] (the drum's motor holds 20 N at the tether) with κ = 1.5, a fallback of
+    /// 0.1 m/s² without the load cell (a realistic reel's acceleration limit,
+    /// `scenarios/paper-reel-limits.toml`), the load cell lost after 5 periods without a sample,
+    /// the attitude's share from |δ| = 0.5 rad to 1.0 rad.
     pub fn dyneema_half_mm() -> Self {
         Self {
             axial_stiffness_n: T::from_f64(10_000.0),
@@ -210,7 +211,7 @@ impl<T: Real> TensionLoopConfig<T> {
             min_tension_n: T::from_f64(0.1),
             max_tension_n: T::from_f64(18.0),
             overshoot: T::from_f64(1.5),
-            fallback_accel_mps2: T::from_f64(4.5e-3),
+            fallback_accel_mps2: T::from_f64(0.1),
             load_cell_timeout_ticks: 5,
             yield_from_rad: T::from_f64(0.5),
             yield_full_rad: T::from_f64(1.0),

@@ -192,7 +192,7 @@ mod tests {
                 "{l}"
             );
         }
-        // Where the cap takes over: ζ_d √(l/(EA m)) = g l/EA … l = EA (2ζ/g)²/m ≈ 58 m.
+        // Where the cap takes over: 2ζ_d √(l/(EA m)) = g l/(EA Δt) … l = EA Δt² (2ζ/g)²/m ≈ 580 m.
         let corner = EA * (2.0 * 0.6 / MAX_GAIN_PERIOD_PRODUCT).powi(2) / M;
         let below = admittance_gain_mps_per_n(corner * 0.99, EA, M, 0.6, 1.0);
         let above = admittance_gain_mps_per_n(corner * 1.01, EA, M, 0.6, 1.0);
