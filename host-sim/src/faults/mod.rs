@@ -23,8 +23,9 @@ pub use report::{
     fault_name, injected_faults, render_fault_summary, FaultSetup, ReelMechanism, EVENTS_SHOWN,
 };
 pub use summary::{
-    FaultEvent, FaultEventKind, FaultSummary, FaultTally, FlagTicks, SummaryBuilder, TickRecord,
-    MAX_EVENTS, TUMBLE_ANGLE_RAD, TautSummary};
+    FaultEvent, FaultEventKind, FaultSummary, FaultTally, FlagTicks, SummaryBuilder, TautSummary,
+    TickRecord, MAX_EVENTS, TUMBLE_ANGLE_RAD,
+};
 
 // ---- what is injected: the fault model's parameters -------------------------------------------
 
