@@ -7,7 +7,8 @@
 use std::path::Path;
 
 use tss_sim::history::{History, PhaseLabel};
-use tss_sim::scenario::{CorruptSection, Scenario, SensorName};
+use tss_sim::scenario::{CorruptSection, Scenario};
+use tss_sim::sensors::SensedQuantity;
 use tss_sim::sim;
 
 fn load(set: &[&str]) -> Scenario {
@@ -120,7 +121,7 @@ fn the_stage_2_slew_is_shaped_within_the_motors_torque() {
 fn a_lost_load_cell_degrades_the_loop_and_the_mission_goes_on() {
     let mut sc = load(&[]);
     sc.faults.corrupt.push(CorruptSection {
-        sensor: SensorName::Tension,
+        sensor: SensedQuantity::Tension,
         from_s: 20_000.0,
         until_s: f64::INFINITY,
         value: f64::NAN,

@@ -31,7 +31,7 @@
 //! Hello   (firmware → plant, once at start, n = 9)
 //!         config_digest u32 (of its built-in configuration, Config::flight), period_ms u32,
 //!         timeout_periods u8
-//! Params  (plant → firmware, once, after Hello, n = 4 × PARAM_WORDS = 236)
+//! Params  (plant → firmware, once, after Hello, n = 4 × PARAM_WORDS = 280)
 //!         the controller configuration to fly, as the parameter table (params.rs): its
 //!         words, u32 each
 //! Loaded  (firmware → plant, the answer to Params, n = 7)
@@ -61,7 +61,7 @@
 //! carried α and α̇ always, and no reel rate, tension or true anomaly; a command no NIS.
 //! Version 2 had no `Params` and `Loaded`: the firmware flew its built-in configuration.
 //!
-//! The largest frame (Params) is 6 + 236 + 4 = 246 bytes decoded, [`MAX_WIRE_LEN`] on the wire.
+//! The largest frame (Params) is 6 + 280 + 4 = 290 bytes decoded, [`MAX_WIRE_LEN`] on the wire.
 //!
 //! # What the receiver checks, in order
 //!
@@ -88,8 +88,8 @@ pub const HEADER_LEN: usize = 6;
 /// Length of the CRC that closes every decoded frame.
 pub const CRC_LEN: usize = 4;
 
-/// Largest decoded frame (header, the largest body, CRC), bytes.
-pub const MAX_FRAME_LEN: usize = 256;
+/// Largest decoded frame (header, the largest body, CRC), bytes: the `Params` frame's.
+pub const MAX_FRAME_LEN: usize = HEADER_LEN + 4 * PARAM_WORDS + CRC_LEN;
 
 /// Largest frame on the wire: COBS adds one byte per 254 (and one), plus the `0x00` delimiter.
 pub const MAX_WIRE_LEN: usize = MAX_FRAME_LEN + MAX_FRAME_LEN / 254 + 2;
@@ -103,7 +103,7 @@ pub const MAX_TICKS: u32 = 200_000;
 pub const DELIMITER: u8 = 0x00;
 
 /// CRC-32/ISO-HDLC (the Ethernet/zlib CRC): poly 0x04C11DB7 reflected, init and xorout all ones.
-/// Bitwise, without the 1 KiB lookup table: flash is tight, and a frame is at most 256 bytes.
+/// Bitwise, without the 1 KiB lookup table: flash is tight, and a frame is at most `MAX_FRAME_LEN` (290) bytes.
 const CRC32: crc::Crc<u32, crc::NoTable> =
     crc::Crc::<u32, crc::NoTable>::new(&crc::CRC_32_ISO_HDLC);
 
@@ -394,6 +394,9 @@ pub struct Loaded {
 pub const NO_PARAM: u8 = 0xff;
 
 /// One message: the frame's kind and body.
+// The parameter table is the one large body, sent once a run; a no_std link has no heap to
+// box it in, and a message lives in one receive slot whatever its kind.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Message {

@@ -17,7 +17,7 @@ use serde::ser::SerializeTuple;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::config::{ConfigError, RateSource, Rule, Stage1Config, Stage2Config};
-use crate::controller::{Config, Envelope, MonitorConfig, ProtectionConfig};
+use crate::controller::{Config, Envelope, MonitorConfig, ProtectionConfig, TensionLoopConfig};
 use crate::estimator;
 use crate::law::Gains;
 use crate::mass::MassModel;
@@ -37,7 +37,7 @@ pub enum WordKind {
 }
 
 /// Words in a table.
-pub const PARAM_WORDS: usize = 59;
+pub const PARAM_WORDS: usize = 70;
 
 /// The table's words in order: the field path (as [`ConfigError::param`] names it) and kind.
 pub const PARAMS: [(&str, WordKind); PARAM_WORDS] = {
@@ -102,6 +102,17 @@ pub const PARAMS: [(&str, WordKind); PARAM_WORDS] = {
         ("rate_source.estimator.initial_disturbance_std_radps2", F32),
         ("rate_source.estimator.gate_nis", F32),
         ("rate_source.estimator.max_rejections", U32),
+        ("tension_loop?", Tag),
+        ("tension_loop.axial_stiffness_n", F32),
+        ("tension_loop.damping_ratio", F32),
+        ("tension_loop.washout_s", F32),
+        ("tension_loop.min_tension_n", F32),
+        ("tension_loop.max_tension_n", F32),
+        ("tension_loop.overshoot", F32),
+        ("tension_loop.fallback_accel_mps2", F32),
+        ("tension_loop.load_cell_timeout_ticks", U32),
+        ("tension_loop.yield_from_rad", F32),
+        ("tension_loop.yield_full_rad", F32),
     ]
 };
 
@@ -213,6 +224,8 @@ impl Reader<'_> {
 const PROTECTION_WORDS: usize = 5;
 /// Words of the estimator's part (after its tag).
 const ESTIMATOR_WORDS: usize = 9;
+/// Words of the tension loop's part (after its tag).
+const TENSION_LOOP_WORDS: usize = 10;
 
 impl ParamTable {
     /// The table of `cfg`.
@@ -230,6 +243,7 @@ impl ParamTable {
             monitor,
             protection,
             rate_source,
+            tension_loop,
         } = cfg;
         let Orbit {
             semi_major_axis_m,
@@ -398,6 +412,40 @@ impl ParamTable {
                 }
             }
         }
+        match tension_loop {
+            Some(t) => {
+                let TensionLoopConfig {
+                    axial_stiffness_n,
+                    damping_ratio,
+                    washout_s,
+                    min_tension_n,
+                    max_tension_n,
+                    overshoot,
+                    fallback_accel_mps2,
+                    load_cell_timeout_ticks,
+                    yield_from_rad,
+                    yield_full_rad,
+                } = t;
+                w.word(1);
+                w.f32s(&[
+                    *axial_stiffness_n,
+                    *damping_ratio,
+                    *washout_s,
+                    *min_tension_n,
+                    *max_tension_n,
+                    *overshoot,
+                    *fallback_accel_mps2,
+                ]);
+                w.word(*load_cell_timeout_ticks);
+                w.f32s(&[*yield_from_rad, *yield_full_rad]);
+            }
+            None => {
+                w.word(0);
+                for _ in 0..TENSION_LOOP_WORDS {
+                    w.word(0);
+                }
+            }
+        }
         Self { words: w.words }
     }
 
@@ -501,6 +549,23 @@ impl ParamTable {
             r.zeros(ESTIMATOR_WORDS)?;
             RateSource::Sensor
         };
+        let tension_loop = if r.tag()? {
+            Some(TensionLoopConfig {
+                axial_stiffness_n: r.f32(),
+                damping_ratio: r.f32(),
+                washout_s: r.f32(),
+                min_tension_n: r.f32(),
+                max_tension_n: r.f32(),
+                overshoot: r.f32(),
+                fallback_accel_mps2: r.f32(),
+                load_cell_timeout_ticks: r.word(),
+                yield_from_rad: r.f32(),
+                yield_full_rad: r.f32(),
+            })
+        } else {
+            r.zeros(TENSION_LOOP_WORDS)?;
+            None
+        };
         Ok(Config {
             period_s,
             orbit,
@@ -514,6 +579,7 @@ impl ParamTable {
             monitor,
             protection,
             rate_source,
+            tension_loop,
         })
     }
 }

@@ -13,7 +13,7 @@
 //! TC[8,1]    perform a function        app data: function id u16 (ModeCommand), 2 bytes
 //! TC[9,128]  set the on-board time     app data: mission tick u32, 4 bytes
 //! TC[20,128] load the parameter table  app data: PARAM_WORDS words u32, then their CRC-32
-//!                                      (ISO-HDLC) u32: 4 × 59 + 4 = 240 bytes
+//!                                      (ISO-HDLC) u32: 4 × 70 + 4 = 284 bytes
 //! ```
 //!
 //! Integers are big-endian, as CCSDS and PUS fields are. A telecommand's checks, in order:
