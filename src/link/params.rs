@@ -702,7 +702,16 @@ mod tests {
         let crate::config::RateSource::Estimator(est) = Config::<f32>::flight().rate_source else {
             panic!("the flight configuration flies the estimator");
         };
-        assert_eq!(t.words[PARAM_WORDS - 1], u32::from(est.max_rejections));
+        let max_rejections = at("rate_source.estimator.max_rejections");
+        assert_eq!(t.words[max_rejections], u32::from(est.max_rejections));
+        assert_eq!(t.words[at("tension_loop?")], 1);
+        let loop_cfg = Config::<f32>::flight()
+            .tension_loop
+            .expect("the flight loop");
+        assert_eq!(
+            t.words[at("tension_loop.load_cell_timeout_ticks")],
+            loop_cfg.load_cell_timeout_ticks
+        );
         for (i, (_, kind)) in PARAMS.iter().enumerate() {
             if *kind == WordKind::Tag {
                 assert!(t.words[i] <= 1);
@@ -723,11 +732,15 @@ mod tests {
         let mut t = good;
         t.words[tag + 3] = 1;
         assert_eq!(t.to_config(), Err(TableError::NotZero((tag + 3) as u8)));
+        let max_rejections = PARAMS
+            .iter()
+            .position(|(n, _)| *n == "rate_source.estimator.max_rejections")
+            .unwrap();
         let mut t = ParamTable::from_config(&Config::flight());
-        t.words[PARAM_WORDS - 1] = 70_000;
+        t.words[max_rejections] = 70_000;
         assert_eq!(
             t.to_config(),
-            Err(TableError::TooLarge((PARAM_WORDS - 1) as u8))
+            Err(TableError::TooLarge(max_rejections as u8))
         );
     }
 
