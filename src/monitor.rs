@@ -1,6 +1,7 @@
 //! Sensor monitoring: every sensed value is checked before use (as PX4's `_inputValid()`
 //! does) — finite, inside its physical range, and consistent with what came before (no length
-//! jump the reel cannot make, no angle jump, no stuck angle sensor).
+//! jump the reel cannot make, no angle jump, no stuck angle sensor, no reel rate the reel
+//! cannot run at).
 //!
 //! A rejected sample never reaches the law; the controller takes its documented safe action
 //! (see [`crate::controller`]).
@@ -53,7 +54,9 @@ pub enum Sensor {
     Alpha,
     /// α jumped further than α̇ allows (flying on a rate sensor).
     AlphaJump,
-    /// α repeats exactly while α̇ says the tether is moving (flying on a rate sensor).
+    /// α repeats exactly while α̇ says the tether is moving (flying on a rate sensor), or
+    /// `stuck_ticks` times in a row, which the swing sensor's noise does not allow (flying on
+    /// the estimator: docs/equations.md §13, *A frozen swing sensor*).
     AlphaStuck,
     /// α failed the estimator's χ² innovation gate (flying on the estimator: an outlier, or a
     /// sensor that jumped or stuck; see [`crate::estimator`], *Gating and faults*).
@@ -66,6 +69,10 @@ pub enum Sensor {
     AlphaRate,
     /// Orbit rate NaN, infinite or outside [min, max].
     OrbitRate,
+    /// The encoder's reel rate NaN, infinite, or faster than the envelope's rate limit by
+    /// more than [`REEL_RATE_MARGIN`]: the sample is rejected, and the estimator's drive over
+    /// the period is the command.
+    ReelRate,
 }
 
 /// Shortest length a length sensor can plausibly report, m (1 mm): anything shorter is a
@@ -74,6 +81,11 @@ pub const MIN_PLAUSIBLE_LENGTH_M: f64 = 1e-3;
 
 /// A sensed length beyond the spool end by more than this fraction is a sensor fault.
 pub const SPOOL_MARGIN: f64 = 0.05;
+
+/// A reel rate beyond the envelope's rate limit by more than this fraction is a sensor fault:
+/// the drive follows its command within its acceleration limit and never runs half again
+/// faster than the fastest command.
+pub const REEL_RATE_MARGIN: f64 = 0.5;
 
 /// What the law may use of an accepted sample's swing sensing.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -91,8 +103,18 @@ enum AngleChecks<T> {
     /// against the last accepted sample (`None` before the first).
     RateSensor(Option<Accepted<T>>),
     /// Flying on the estimator: α optional (a dropout of the swing sensor alone is not a bad
-    /// sample), α̇ ignored; the estimator's innovation gate replaces the jump and stuck checks.
-    Estimator,
+    /// sample), α̇ ignored; the estimator's innovation gate replaces the jump check, and a run
+    /// of identical readings the sensor's noise cannot make is a frozen sensor (`None` before
+    /// the first α).
+    Estimator(Option<Repeats<T>>),
+}
+
+/// The run of bit-identical α readings the last accepted α ends (flying on the estimator).
+#[derive(Clone, Copy, Debug)]
+struct Repeats<T> {
+    alpha_rad: T,
+    /// Readings of this α in a row, including any rejected as stuck since.
+    count: u32,
 }
 
 /// The last accepted sample, for the consistency checks, and the run of identical α
@@ -115,6 +137,8 @@ pub(crate) struct Monitor<T> {
     min_length_m: T,
     /// The spool end plus [`SPOOL_MARGIN`], m.
     max_length_m: T,
+    /// The envelope's rate limit plus [`REEL_RATE_MARGIN`], m/s.
+    max_reel_rate_mps: T,
     /// The angle checks of the rate source.
     angles: AngleChecks<T>,
 }
@@ -131,10 +155,10 @@ fn magnitude_within<T: Real>(v: T, max: T) -> bool {
 
 impl<T: Real> Monitor<T> {
     /// A monitor for a validated configuration: `spool_m` is the longest plausible length (the
-    /// spool end plus [`SPOOL_MARGIN`]); `rate_sensor` when the law flies on a sensed α̇.
-    /// Fails if the length is not finite or below [`MIN_PLAUSIBLE_LENGTH_M`] (no length could
-    /// ever be accepted).
-    pub(crate) fn new(spool_m: T, rate_sensor: bool) -> Result<Self, ConfigError> {
+    /// spool end plus [`SPOOL_MARGIN`]); `max_rate_mps` the envelope's rate limit;
+    /// `rate_sensor` when the law flies on a sensed α̇. Fails if the length is not finite or
+    /// below [`MIN_PLAUSIBLE_LENGTH_M`] (no length could ever be accepted).
+    pub(crate) fn new(spool_m: T, max_rate_mps: T, rate_sensor: bool) -> Result<Self, ConfigError> {
         let min_length_m = T::from_f64(MIN_PLAUSIBLE_LENGTH_M);
         if !spool_m.is_finite() {
             return Err(ConfigError::new(
@@ -153,10 +177,11 @@ impl<T: Real> Monitor<T> {
         Ok(Self {
             min_length_m,
             max_length_m: spool_m,
+            max_reel_rate_mps: max_rate_mps * T::from_f64(1.0 + REEL_RATE_MARGIN),
             angles: if rate_sensor {
                 AngleChecks::RateSensor(None)
             } else {
-                AngleChecks::Estimator
+                AngleChecks::Estimator(None)
             },
         })
     }
@@ -179,6 +204,11 @@ impl<T: Real> Monitor<T> {
         if !within(x.length_m, self.min_length_m, self.max_length_m) {
             return Err(Sensor::Length);
         }
+        if let Some(r) = x.reel_rate_mps {
+            if !magnitude_within(r, self.max_reel_rate_mps) {
+                return Err(Sensor::ReelRate);
+            }
+        }
         let pi = T::from_f64(core::f64::consts::PI);
         let swing = match self.angles {
             AngleChecks::RateSensor(_) => {
@@ -193,7 +223,7 @@ impl<T: Real> Monitor<T> {
                 };
                 Swing::Sensed(alpha_rad, alpha_rate_radps)
             }
-            AngleChecks::Estimator => match x.alpha_rad {
+            AngleChecks::Estimator(_) => match x.alpha_rad {
                 Some(a) if !magnitude_within(a, pi) => return Err(Sensor::Alpha),
                 alpha => Swing::Angle(alpha),
             },
@@ -210,12 +240,42 @@ impl<T: Real> Monitor<T> {
                 return Err(Sensor::LengthJump);
             }
         }
-        if let (AngleChecks::RateSensor(last), Swing::Sensed(alpha_rad, alpha_rate_radps)) =
-            (&mut self.angles, swing)
-        {
-            Self::consistent(cfg, last, x.tick, alpha_rad, alpha_rate_radps, period_s)?;
+        match (&mut self.angles, swing) {
+            (AngleChecks::RateSensor(last), Swing::Sensed(alpha_rad, alpha_rate_radps)) => {
+                Self::consistent(cfg, last, x.tick, alpha_rad, alpha_rate_radps, period_s)?
+            }
+            (AngleChecks::Estimator(run), Swing::Angle(Some(alpha_rad))) => {
+                Self::not_frozen(cfg, run, alpha_rad)?
+            }
+            _ => {}
         }
         Ok(swing)
+    }
+
+    /// The frozen-sensor check flying on the estimator: the `stuck_ticks`-th bit-identical α
+    /// in a row, and every one after it, is rejected (docs/equations.md §13, *A frozen swing
+    /// sensor*: a sensor with the estimator's noise model repeats a reading with probability
+    /// below q/(2σ√π) per period, moving or not).
+    fn not_frozen(
+        cfg: &MonitorConfig<T>,
+        run: &mut Option<Repeats<T>>,
+        alpha_rad: T,
+    ) -> Result<(), Sensor> {
+        match run {
+            Some(r) if r.alpha_rad == alpha_rad => {
+                r.count = r.count.saturating_add(1);
+                if r.count >= cfg.stuck_ticks {
+                    return Err(Sensor::AlphaStuck);
+                }
+            }
+            _ => {
+                *run = Some(Repeats {
+                    alpha_rad,
+                    count: 1,
+                })
+            }
+        }
+        Ok(())
     }
 
     /// The α-jump and α-stuck checks of a sensed α and α̇ at `tick`, against the last accepted
@@ -285,7 +345,7 @@ mod tests {
     #[test]
     fn alpha_jump_is_judged_against_the_last_accepted_sample() {
         let cfg = MonitorConfig::<f64>::default_for_period();
-        let mut m = Monitor::new(42_000.0, true).unwrap();
+        let mut m = Monitor::new(42_000.0, 15.0, true).unwrap();
         // No previous sample: any α in range is accepted.
         assert_eq!(
             m.check(&cfg, &sample(5, 3.0, 0.01), None, 1.0).map(drop),
@@ -323,7 +383,7 @@ mod tests {
             stuck_motion_rad: 0.015,
             ..MonitorConfig::default_for_period()
         };
-        let mut m = Monitor::new(42_000.0, true).unwrap();
+        let mut m = Monitor::new(42_000.0, 15.0, true).unwrap();
         // 0.0 rad is not mistaken for a repeat of anything before the first reading.
         assert_eq!(
             m.check(&cfg, &sample(0, 0.0, 0.01), None, 1.0).map(drop),
@@ -452,7 +512,7 @@ mod tests {
             ),
         ];
         for (x, expected) in cases {
-            let mut m = Monitor::new(42_000.0_f32, true).unwrap();
+            let mut m = Monitor::new(42_000.0_f32, 15.0, true).unwrap();
             assert_eq!(m.check(&cfg, &x, None, 1.0), Err(expected), "{x:?}");
         }
         for x in [
@@ -470,7 +530,7 @@ mod tests {
                 ..ok
             },
         ] {
-            let mut m = Monitor::new(42_000.0_f32, true).unwrap();
+            let mut m = Monitor::new(42_000.0_f32, 15.0, true).unwrap();
             assert_eq!(m.check(&cfg, &x, None, 1.0).map(drop), Ok(()), "{x:?}");
         }
     }
@@ -478,7 +538,7 @@ mod tests {
     #[test]
     fn on_the_estimator_alpha_is_optional_its_rate_ignored_and_jumps_left_to_the_gate() {
         let cfg = MonitorConfig::<f64>::default_for_period();
-        let mut m = Monitor::new(42_000.0, false).unwrap();
+        let mut m = Monitor::new(42_000.0, 15.0, false).unwrap();
         let x = |tick, alpha_rad: Option<f64>, rate: Option<f64>| Input {
             alpha_rad,
             alpha_rate_radps: rate,

@@ -863,3 +863,142 @@ fn a_gap_in_the_calls_longer_than_the_estimator_carries_drops_the_estimate() {
     assert_eq!((e.alpha_rad, e.alpha_rate_radps), (-0.7, 0.0));
     assert_eq!(o.nis, None);
 }
+
+fn flight() -> Controller<f32> {
+    Controller::new(Config::flight()).unwrap()
+}
+
+/// A swing sensor's reading on the estimator path: α near −0.7 rad with a sensor-like
+/// variation of a few 1e-5 rad, never the same twice in a row.
+fn noisy_alpha(tick: u32) -> f32 {
+    -0.7 + 1e-5 * ((tick * 7) % 11) as f32
+}
+
+#[test]
+fn on_the_estimator_a_frozen_swing_sensor_is_stuck_after_stuck_ticks_readings() {
+    let stuck_ticks = Config::<f32>::flight().monitor.stuck_ticks;
+    let mut ctl = flight();
+    let mut l = 100.0;
+    for tick in 0..50 {
+        let x = Input {
+            alpha_rad: Some(noisy_alpha(tick)),
+            alpha_rate_radps: None,
+            ..sample(tick, l)
+        };
+        let o = *ctl.step(&x);
+        assert_eq!(o.fault, None, "tick {tick}");
+        l += o.rate_cmd_mps;
+    }
+    // Frozen from tick 50: the reading of tick 50 repeats; the stuck_ticks-th is rejected.
+    let frozen = noisy_alpha(50);
+    for tick in 50..50 + stuck_ticks + 40 {
+        let x = Input {
+            alpha_rad: Some(frozen),
+            alpha_rate_radps: None,
+            ..sample(tick, l)
+        };
+        let o = *ctl.step(&x);
+        l += o.rate_cmd_mps;
+        let run = tick - 50 + 1;
+        if run < stuck_ticks {
+            assert_eq!(o.fault, None, "reading {run} of the run");
+        } else {
+            assert_eq!(o.fault, Some(Fault::Sensor(Sensor::AlphaStuck)), "{run}");
+        }
+        // A stuck sample is a bad sample: coast_ticks (30) of coasting, then safe hold.
+        if run == stuck_ticks + 31 {
+            assert_eq!(o.health, Health::SafeHold);
+        }
+    }
+    // A reading that moves again ends the run.
+    let x = Input {
+        alpha_rad: Some(frozen + 1e-5),
+        alpha_rate_radps: None,
+        ..sample(50 + stuck_ticks + 40, l)
+    };
+    assert_ne!(ctl.step(&x).fault, Some(Fault::Sensor(Sensor::AlphaStuck)));
+}
+
+#[test]
+fn a_reel_rate_the_reel_cannot_run_at_is_a_bad_sample() {
+    let max = Config::<f32>::flight().envelope.max_rate_mps;
+    for make in [flight, paper] {
+        for bad in [f32::NAN, f32::INFINITY, -1000.0, 1.5 * max * 1.001] {
+            let mut ctl = make();
+            let mut l = 100.0;
+            for tick in 0..3 {
+                let x = Input {
+                    reel_rate_mps: Some(0.1),
+                    ..sample(tick, l)
+                };
+                assert_eq!(ctl.step(&x).fault, None);
+                l += 0.1;
+            }
+            let x = Input {
+                reel_rate_mps: Some(bad),
+                ..sample(3, l)
+            };
+            let o = *ctl.step(&x);
+            assert_eq!(o.fault, Some(Fault::Sensor(Sensor::ReelRate)), "{bad}");
+            assert_eq!(o.health, Health::Degraded, "{bad}");
+            assert!(o.rate_cmd_mps.is_finite());
+            // The next good rate is accepted again.
+            let x = Input {
+                reel_rate_mps: Some(0.1),
+                ..sample(4, l + 0.1)
+            };
+            assert_eq!(ctl.step(&x).fault, None, "{bad}");
+        }
+        // Inside the envelope's rate plus the margin: accepted.
+        let mut ctl = make();
+        let x = Input {
+            reel_rate_mps: Some(-1.5 * max * 0.999),
+            ..sample(0, 100.0)
+        };
+        assert_eq!(ctl.step(&x).fault, None);
+    }
+}
+
+#[test]
+fn a_libration_beyond_the_laws_domain_is_safe_hold_at_once() {
+    use tss_reel::controller::MAX_LIBRATION_RAD;
+    let beyond = -(MAX_LIBRATION_RAD as f32) * 1.01;
+    // On the rate sensor the sensed α is judged; on the estimator α̂, started from this α.
+    for (make, rate) in [
+        (paper as fn() -> Controller<f32>, Some(0.0)),
+        (flight, None),
+    ] {
+        let mut ctl = make();
+        for tick in 0..3 {
+            let x = Input {
+                alpha_rad: Some(beyond - 1e-5 * tick as f32),
+                alpha_rate_radps: rate,
+                ..sample(tick, 100.0)
+            };
+            let o = *ctl.step(&x);
+            assert_eq!(o.fault, Some(Fault::Libration), "tick {tick}");
+            // At once, not after coast_ticks of coasting.
+            assert_eq!(o.health, Health::SafeHold, "tick {tick}");
+            assert!(o.flags.contains(Flags::SAFE_ACTION));
+        }
+        // Back inside: recovery_ticks (10) valid samples in a row, then the law again.
+        let mut out = None;
+        for tick in 3..14 {
+            let x = Input {
+                alpha_rad: Some(-0.7 - 1e-5 * tick as f32),
+                alpha_rate_radps: rate,
+                ..sample(tick, 100.0)
+            };
+            out = Some(*ctl.step(&x));
+        }
+        let o = out.unwrap();
+        assert_eq!(o.fault, None);
+    }
+    // At the bound itself, the law flies.
+    let mut ctl = paper();
+    let x = Input {
+        alpha_rad: Some(-(MAX_LIBRATION_RAD as f32)),
+        ..sample(0, 100.0)
+    };
+    assert_ne!(ctl.step(&x).fault, Some(Fault::Libration));
+}

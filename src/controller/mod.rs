@@ -66,8 +66,18 @@
 //!   [`MAX_ALPHA_VARIANCE_IN_SAMPLES`] times the α sample's variance R (its standard deviation
 //!   ten times the sensor's), or no estimate at all (before the first α, or after the filter
 //!   dropped it: [`EventKind::EstimateLost`]) — then [`Sensor::AlphaLost`];
-//! - α̇ in the sample is not looked at; the monitor's α-jump and α-stuck checks (judged on a
-//!   sensed α̇) give way to the gate.
+//! - α̇ in the sample is not looked at; the monitor's α-jump check (judged on a sensed α̇)
+//!   gives way to the gate, and its α-stuck check to a run of `stuck_ticks` bit-identical α
+//!   readings, which the sensor's noise does not make ([`Sensor::AlphaStuck`],
+//!   docs/equations.md §13);
+//! - the encoder's reel rate, the drive of the prediction, is checked by the monitor
+//!   ([`Sensor::ReelRate`]): a sample with a reel rate it rejects is a bad sample, and the
+//!   estimate is carried over the period at the command.
+//!
+//! On either rate source, an α (sensed, or α̂) beyond [`MAX_LIBRATION_RAD`] is a libration
+//! beyond the law's domain ([`Fault::Libration`]): safe hold at once, the reel brought to rest
+//! (at a constant length the swing's energy is conserved, and pays out or winds in no more), until
+//! `recovery_ticks` samples in a row are back inside.
 
 mod clock;
 mod drive;
@@ -107,7 +117,7 @@ use tension::{StageInput, TensionStage};
 
 pub use tension::TensionLoopMode;
 
-pub use estimation::{MAX_ALPHA_VARIANCE_IN_SAMPLES, MAX_CARRIED_PERIODS};
+pub use estimation::{MAX_ALPHA_VARIANCE_IN_SAMPLES, MAX_CARRIED_PERIODS, MAX_LIBRATION_RAD};
 pub use sequencer::PROGRESS_TIME_CONSTANTS;
 
 /// Bound on the reported [`Output::equilibrium_margin`] (x grows as 1/l toward docking).
@@ -127,6 +137,8 @@ pub struct Controller<T: Real> {
     estimation: Option<Estimation<T>>,
     /// The tension loop between the law and the limits (None: not configured).
     tension: Option<TensionStage<T>>,
+    /// [`MAX_LIBRATION_RAD`], rad.
+    max_libration_rad: T,
     sequencer: Sequencer<T>,
     health: HealthMachine,
     length: DeadReckoning<T>,
@@ -296,11 +308,12 @@ impl<T: Real> Controller<T> {
                 )
             }),
             existence,
-            monitor: Monitor::new(spool_m, estimation.is_none())?,
+            monitor: Monitor::new(spool_m, cfg.envelope.max_rate_mps, estimation.is_none())?,
             estimation,
             tension: cfg.tension_loop.map(|t| {
                 TensionStage::new(t, cfg.masses, cfg.period_s, cfg.envelope.max_accel_mps2)
             }),
+            max_libration_rad: T::from_f64(MAX_LIBRATION_RAD),
             reported: Reported {
                 health: Health::Nominal,
                 phase: sequencer.phase(),
@@ -534,6 +547,13 @@ impl<T: Real> Controller<T> {
                 length_m: Some(x.length_m),
                 alpha_ref_rad: None,
             }),
+            (Ok((x, _)), Ok((alpha_rad, _))) if !(alpha_rad.abs() <= self.max_libration_rad) => {
+                Err(Unusable {
+                    fault: Fault::Libration,
+                    length_m: Some(x.length_m),
+                    alpha_ref_rad: None,
+                })
+            }
             (Ok((x, _)), Ok((alpha_rad, alpha_rate_radps))) => {
                 self.length.sensed(x.length_m);
                 Ok(Sensed {
@@ -719,11 +739,15 @@ impl<T: Real> Controller<T> {
         }
     }
 
-    /// No usable sample or no law solution at this tick: the health machine counts it, and
-    /// the length to coast from becomes the length estimate. Then the safe action.
+    /// No usable sample or no law solution at this tick: the health machine counts it (a
+    /// libration beyond the law's domain is safe hold at once), and the length to coast from
+    /// becomes the length estimate. Then the safe action.
     fn reject(&mut self, tick: u32, unusable: Unusable<T>) -> Decided<T> {
         self.length.coast(unusable.length_m);
-        self.health.unusable(&self.cfg.monitor);
+        match unusable.fault {
+            Fault::Libration => self.health.force_safe_hold(),
+            _ => self.health.unusable(&self.cfg.monitor),
+        }
         // Without a usable sample, α_r is reported at the estimated length.
         let alpha_ref_rad = unusable.alpha_ref_rad.unwrap_or_else(|| {
             let l = self.length.length_m().unwrap_or(T::ZERO);

@@ -57,6 +57,10 @@ pub enum Fault {
     Sensor(Sensor),
     /// The law is at one of its singular points.
     Law(LawFault),
+    /// The swing the law flies on (sensed α, or α̂) is beyond
+    /// [`MAX_LIBRATION_RAD`](super::MAX_LIBRATION_RAD): a libration outside the law's domain,
+    /// on its way to a tumble. Safe hold at once.
+    Libration,
 }
 
 /// Status bits reported with every command.

@@ -46,7 +46,7 @@ pub fn health_from_code(c: u8) -> Option<Health> {
         .find(|&h| health_code(h) == c)
 }
 
-pub(super) const SENSOR_FAULTS: [Sensor; 11] = [
+pub(super) const SENSOR_FAULTS: [Sensor; 12] = [
     Sensor::Missing,
     Sensor::Tick,
     Sensor::Length,
@@ -58,6 +58,7 @@ pub(super) const SENSOR_FAULTS: [Sensor; 11] = [
     Sensor::OrbitRate,
     Sensor::AlphaGated,
     Sensor::AlphaLost,
+    Sensor::ReelRate,
 ];
 
 pub(super) const LAW_FAULTS: [LawFault; 4] = [
@@ -67,7 +68,8 @@ pub(super) const LAW_FAULTS: [LawFault; 4] = [
     LawFault::NotFinite,
 ];
 
-/// The wire code of a fault: 0 none, `0x10 + n` sensor fault n, `0x20 + n` law fault n (n in
+/// The wire code of a fault: 0 none, `0x10 + n` sensor fault n, `0x20 + n` law fault n, `0x30` a
+/// libration beyond the law's domain (n in
 /// declaration order).
 pub fn fault_code(f: Option<Fault>) -> u8 {
     match f {
@@ -85,6 +87,7 @@ pub fn fault_code(f: Option<Fault>) -> u8 {
                 Sensor::OrbitRate => 8,
                 Sensor::AlphaGated => 9,
                 Sensor::AlphaLost => 10,
+                Sensor::ReelRate => 11,
             }
         }
         Some(Fault::Law(l)) => {
@@ -95,6 +98,7 @@ pub fn fault_code(f: Option<Fault>) -> u8 {
                 LawFault::NotFinite => 3,
             }
         }
+        Some(Fault::Libration) => 0x30,
     }
 }
 
@@ -107,6 +111,7 @@ pub fn fault_from_code(c: u8) -> Result<Option<Fault>, LinkError> {
     let law = LAW_FAULTS.into_iter().map(Fault::Law);
     sensor
         .chain(law)
+        .chain([Fault::Libration])
         .find(|&f| fault_code(Some(f)) == c)
         .map(Some)
         .ok_or(LinkError::Malformed)

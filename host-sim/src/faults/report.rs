@@ -24,6 +24,7 @@ pub fn fault_name(f: Fault) -> String {
     match f {
         Fault::Sensor(s) => format!("sensor {s:?}"),
         Fault::Law(l) => format!("law {l:?}"),
+        Fault::Libration => "libration beyond the law's domain".to_string(),
     }
 }
 
