@@ -137,8 +137,6 @@ pub struct Controller<T: Real> {
     estimation: Option<Estimation<T>>,
     /// The tension loop between the law and the limits (None: not configured).
     tension: Option<TensionStage<T>>,
-    /// [`MAX_LIBRATION_RAD`], rad.
-    max_libration_rad: T,
     sequencer: Sequencer<T>,
     health: HealthMachine,
     length: DeadReckoning<T>,
@@ -313,7 +311,6 @@ impl<T: Real> Controller<T> {
             tension: cfg.tension_loop.map(|t| {
                 TensionStage::new(t, cfg.masses, cfg.period_s, cfg.envelope.max_accel_mps2)
             }),
-            max_libration_rad: T::from_f64(MAX_LIBRATION_RAD),
             reported: Reported {
                 health: Health::Nominal,
                 phase: sequencer.phase(),
@@ -547,7 +544,9 @@ impl<T: Real> Controller<T> {
                 length_m: Some(x.length_m),
                 alpha_ref_rad: None,
             }),
-            (Ok((x, _)), Ok((alpha_rad, _))) if !(alpha_rad.abs() <= self.max_libration_rad) => {
+            (Ok((x, _)), Ok((alpha_rad, _)))
+                if alpha_rad.abs() > T::from_f64(MAX_LIBRATION_RAD) =>
+            {
                 Err(Unusable {
                     fault: Fault::Libration,
                     length_m: Some(x.length_m),
