@@ -104,9 +104,9 @@ enum AngleChecks<T> {
     RateSensor(Option<Accepted<T>>),
     /// Flying on the estimator: α optional (a dropout of the swing sensor alone is not a bad
     /// sample), α̇ ignored; the estimator's innovation gate replaces the jump check, and a run
-    /// of identical readings the sensor's noise cannot make is a frozen sensor (`None` before
-    /// the first α).
-    Estimator(Option<Repeats<T>>),
+    /// of identical readings the sensor's noise cannot make is a frozen sensor
+    /// (the monitor's `repeats`).
+    Estimator,
 }
 
 /// The run of bit-identical α readings the last accepted α ends (flying on the estimator).
@@ -141,6 +141,9 @@ pub(crate) struct Monitor<T> {
     max_reel_rate_mps: T,
     /// The angle checks of the rate source.
     angles: AngleChecks<T>,
+    /// Flying on the estimator, the run of identical α readings the last α ends (`None`
+    /// before the first α).
+    repeats: Option<Repeats<T>>,
 }
 
 /// `lo ≤ v ≤ hi` (false for NaN).
@@ -181,8 +184,9 @@ impl<T: Real> Monitor<T> {
             angles: if rate_sensor {
                 AngleChecks::RateSensor(None)
             } else {
-                AngleChecks::Estimator(None)
+                AngleChecks::Estimator
             },
+            repeats: None,
         })
     }
 
@@ -223,9 +227,13 @@ impl<T: Real> Monitor<T> {
                 };
                 Swing::Sensed(alpha_rad, alpha_rate_radps)
             }
-            AngleChecks::Estimator(_) => match x.alpha_rad {
+            AngleChecks::Estimator => match x.alpha_rad {
                 Some(a) if !magnitude_within(a, pi) => return Err(Sensor::Alpha),
-                alpha => Swing::Angle(alpha),
+                Some(a) => {
+                    Self::not_frozen(cfg, &mut self.repeats, a)?;
+                    Swing::Angle(Some(a))
+                }
+                None => Swing::Angle(None),
             },
         };
         if !within(
@@ -240,14 +248,10 @@ impl<T: Real> Monitor<T> {
                 return Err(Sensor::LengthJump);
             }
         }
-        match (&mut self.angles, swing) {
-            (AngleChecks::RateSensor(last), Swing::Sensed(alpha_rad, alpha_rate_radps)) => {
-                Self::consistent(cfg, last, x.tick, alpha_rad, alpha_rate_radps, period_s)?
-            }
-            (AngleChecks::Estimator(run), Swing::Angle(Some(alpha_rad))) => {
-                Self::not_frozen(cfg, run, alpha_rad)?
-            }
-            _ => {}
+        if let (AngleChecks::RateSensor(last), Swing::Sensed(alpha_rad, alpha_rate_radps)) =
+            (&mut self.angles, swing)
+        {
+            Self::consistent(cfg, last, x.tick, alpha_rad, alpha_rate_radps, period_s)?;
         }
         Ok(swing)
     }
