@@ -676,7 +676,8 @@ fn spool_end_holds_with_a_lagging_drive() {
         );
         assert_envelope(f, 0.0);
     }
-    // Without the protection the same drive passes the spool end (the hazard as it was).
+    // Without the protection the same drive passes the spool end (the hazard as it was): the
+    // simulator stops the run where the tether leaves the spool.
     let h = run(
         REEL_LIMITS,
         &[
@@ -686,11 +687,9 @@ fn spool_end_holds_with_a_lagging_drive() {
             "reel.max_accel_mps2=0.1",
         ],
     );
-    assert!(
-        h.faults.max_excursion_m > 5.0,
-        "{}",
-        h.faults.max_excursion_m
-    );
+    let overrun = h.spool_overrun.expect("the unprotected drive runs off the spool");
+    assert!(overrun.length_m > overrun.spool_m, "{overrun:?}");
+    assert!(h.faults.max_excursion_m > 0.0, "{}", h.faults.max_excursion_m);
 }
 
 /// TSS-1R at short length: a 40 s dropout at t = 40 s (l ≈ 5 m) puts the reel in safe hold;
