@@ -38,7 +38,7 @@ use tss_reel::recordings::mission;
 mod bench {
     use core::hint::black_box;
     use nalgebra::{Matrix3, Vector3};
-    use tss_reel::estimator::{Config, Drive, Estimator, Measurement};
+    use tss_reel::estimator::{Config, Drive, Estimator, Measurement, OrbitTerms};
     pub use tss_reel::firmware::bench::{Meter, Stats, K};
 
     /// Logs the distribution of one kind of step.
@@ -77,10 +77,7 @@ mod bench {
             length_m: before[0],
             rate_mps: now[0] - before[0],
             accel_mps2: 0.0,
-            orbit_rate_radps: crate::mission::ORBIT_RATE_RADPS,
-            orbit_accel_radps2: 0.0,
-            gravity_gradient_per_s2: crate::mission::ORBIT_RATE_RADPS
-                * crate::mission::ORBIT_RATE_RADPS,
+            orbit: OrbitTerms::circular(crate::mission::ORBIT_RATE_RADPS).ok()?,
             mu3: 0.0,
         })
     }

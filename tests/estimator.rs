@@ -14,7 +14,9 @@ use proptest::prelude::*;
 use std::path::Path;
 use std::sync::OnceLock;
 use tss_reel::controller::{Controller, Input};
-use tss_reel::estimator::{Config, Drive, Estimate, Estimator, Measurement, Output, Prediction};
+use tss_reel::estimator::{
+    Config, Drive, Estimate, Estimator, Measurement, OrbitTerms, Output, Prediction,
+};
 use tss_reel::Real;
 use tss_sim::plant::{ix, RigidModel, State};
 use tss_sim::scenario::Scenario;
@@ -56,10 +58,13 @@ impl Tick {
             length_m: T::from_f64(self.length_m),
             rate_mps: T::from_f64(self.rate_cmd_mps),
             accel_mps2: T::ZERO,
-            orbit_rate_radps: T::from_f64(self.orbit_rate_radps),
-            orbit_accel_radps2: T::from_f64(self.orbit_accel_radps2),
-            gravity_gradient_per_s2: T::from_f64(self.gravity_gradient_per_s2),
             mu3: T::ZERO,
+            orbit: OrbitTerms::new(
+                T::from_f64(self.orbit_rate_radps),
+                T::from_f64(self.orbit_accel_radps2),
+                T::from_f64(self.gravity_gradient_per_s2),
+            )
+            .expect("the plant's orbit terms are in range"),
         }
     }
 }
@@ -764,9 +769,7 @@ fn updates_after_dropouts_of_any_length_keep_the_covariance_positive_definite() 
         length_m: l,
         rate_mps: v,
         accel_mps2: 0.0,
-        orbit_rate_radps: n,
-        orbit_accel_radps2: 0.0,
-        gravity_gradient_per_s2: n * n,
+        orbit: OrbitTerms::circular(n).expect("in range"),
         mu3: 0.0,
     });
     let mut strongest = 0.0_f64;
@@ -800,9 +803,7 @@ fn a_dropout_of_days_stays_bounded_in_f32() {
         length_m: 30_000.0,
         rate_mps: 0.0,
         accel_mps2: 0.0,
-        orbit_rate_radps: N as f32,
-        orbit_accel_radps2: 0.0,
-        gravity_gradient_per_s2: (N * N) as f32,
+        orbit: OrbitTerms::circular(N as f32).expect("in range"),
         mu3: 0.0,
     };
     est.step(&keep, Some(0.01));
@@ -853,9 +854,7 @@ fn one_period_matches_the_plant() {
             length_m: l,
             rate_mps: v,
             accel_mps2: 0.0,
-            orbit_rate_radps: N,
-            orbit_accel_radps2: 0.0,
-            gravity_gradient_per_s2: N * N,
+            orbit: OrbitTerms::circular(N).expect("in range"),
             mu3: 0.0,
         };
         let e = est.step(&drive, None).estimate.expect("predicted");
@@ -913,9 +912,7 @@ fn the_discretisation_error_against_the_period() {
                 length_m: l,
                 rate_mps: v,
                 accel_mps2: 0.0,
-                orbit_rate_radps: N,
-                orbit_accel_radps2: 0.0,
-                gravity_gradient_per_s2: N * N,
+                orbit: OrbitTerms::circular(N).expect("in range"),
                 mu3: 0.0,
             };
             let e = est.step(&drive, None).estimate.expect("predicted");
@@ -1056,14 +1053,15 @@ fn period() -> impl Strategy<Value = (Drive<f32>, Option<f32>)> {
         proptest::option::weighted(0.9, field(-1.6, 1.6)),
     )
         .prop_map(|(length_m, rate_mps, accel_mps2, orbit, mu3, z)| {
+            // Orbit terms out of range cannot be built ([`OrbitTerms`]'s own tests).
+            let orbit = OrbitTerms::new(orbit.0, orbit.1, orbit.2)
+                .unwrap_or_else(|_| OrbitTerms::circular(1.06e-3).expect("in range"));
             let drive = Drive {
                 length_m,
                 rate_mps,
                 accel_mps2,
-                orbit_rate_radps: orbit.0,
-                orbit_accel_radps2: orbit.1,
-                gravity_gradient_per_s2: orbit.2,
                 mu3,
+                orbit,
             };
             (drive, z)
         })
@@ -1133,9 +1131,9 @@ proptest! {
         };
         match Estimator::new(cfg) {
             Ok(mut est) => {
-                let d = Drive { length_m: 9_000.0, rate_mps: 1.0, accel_mps2: 0.0,
-                                orbit_rate_radps: 1.06e-3, orbit_accel_radps2: 0.0,
-                                gravity_gradient_per_s2: 1.1236e-6, mu3: 0.0 };
+                let orbit = OrbitTerms::circular(1.06e-3).expect("in range");
+                let d = Drive { length_m: 9_000.0, rate_mps: 1.0, accel_mps2: 0.0, mu3: 0.0,
+                                orbit };
                 for _ in 0..10 {
                     let out = est.step(&d, Some(-0.78));
                     let e = out.estimate.expect("estimate");

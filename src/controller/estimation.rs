@@ -5,7 +5,9 @@
 //! it (see the controller's docs, *Flying on the estimator*).
 
 use crate::config::{estimator_error, ConfigError};
-use crate::estimator::{self, Drive, Estimate, Estimator, Measurement, Prediction};
+use crate::estimator::{
+    self, Drive, DriveError, Estimate, Estimator, Measurement, OrbitTerms, Prediction,
+};
 use crate::monitor::Sensor;
 use crate::orbit::Orbit;
 use crate::real::Real;
@@ -32,17 +34,6 @@ pub const MAX_ALPHA_VARIANCE_IN_SAMPLES: f64 = 100.0;
 /// (sin² 1.4). The paper's stage-1 deployment itself swings out to about 1.22 rad at short
 /// lengths (docs/hazards.md, HZ-3), which the bound leaves inside.
 pub const MAX_LIBRATION_RAD: f64 = 1.4;
-
-/// The orbit's terms of the libration dynamics at one sample.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct OrbitTerms<T> {
-    /// θ̇, rad/s.
-    rate_radps: T,
-    /// θ̈, rad/s².
-    accel_radps2: T,
-    /// μ/R³, 1/s².
-    gravity_gradient_per_s2: T,
-}
 
 /// What one step commanded of the reel for the coming period: the drive of the next
 /// prediction.
@@ -78,9 +69,9 @@ pub(super) struct Estimation<T: Real> {
     /// Var(α̂) beyond which the law may not use the estimate, rad².
     max_alpha_var_rad2: T,
     /// The orbit's terms at the last accepted sample (a period without one is carried with
-    /// them); before the first, the configured orbit's at periapsis (no estimate to carry
-    /// then: the estimate starts from an accepted sample's α).
-    orbit: OrbitTerms<T>,
+    /// them), or why they were refused; before the first, the configured orbit's at periapsis
+    /// (no estimate to carry then: the estimate starts from an accepted sample's α).
+    orbit: Result<OrbitTerms<T>, DriveError>,
     /// What the last step commanded (`None` before the first step).
     commanded: Option<Commanded<T>>,
     /// The NIS of the last step's α sample, if one met the estimate.
@@ -102,12 +93,12 @@ impl<T: Real> Estimation<T> {
             filter,
             eccentric,
             max_alpha_var_rad2,
-            orbit: OrbitTerms {
-                rate_radps: orbit.true_anomaly_rate_radps(T::ZERO),
-                // sin θ = 0 at periapsis; 0 for good on a circular orbit (`sense_orbit`).
-                accel_radps2: T::ZERO,
-                gravity_gradient_per_s2: orbit.gravity_gradient_per_s2(T::ZERO),
-            },
+            // sin θ = 0 at periapsis: θ̈ = 0.
+            orbit: OrbitTerms::new(
+                orbit.true_anomaly_rate_radps(T::ZERO),
+                T::ZERO,
+                orbit.gravity_gradient_per_s2(T::ZERO),
+            ),
             commanded: None,
             nis: None,
             useless: false,
@@ -201,16 +192,23 @@ impl<T: Real> Estimation<T> {
     }
 
     /// Carries the estimate over the `k`-th period since the last step (see [`Self::drive`]);
-    /// `true` if the filter dropped it.
+    /// `true` if the filter dropped it. Without a command yet the estimate is dropped
+    /// (nothing says how the reel moved); with orbit terms refused, too (as a refused drive).
     fn carry(&mut self, k: u32, reel_rate_mps: Option<T>) -> bool {
-        match self.drive(k, reel_rate_mps) {
-            Some(drive) => matches!(
-                self.filter.predict_period(&drive),
+        let Some(c) = self.commanded else {
+            self.filter.reset();
+            return false;
+        };
+        match self.orbit {
+            Ok(orbit) => matches!(
+                self.filter
+                    .predict_period(&self.drive(&c, orbit, k, reel_rate_mps)),
                 Prediction::InvalidDrive(_) | Prediction::Diverged
             ),
-            None => {
+            Err(_) => {
+                let had = self.filter.estimate().is_some();
                 self.filter.reset();
-                false
+                had
             }
         }
     }
@@ -229,45 +227,42 @@ impl<T: Real> Estimation<T> {
         lost
     }
 
-    /// Keeps the orbit's terms at a sample: θ̈ and μ/R³ from θ on an eccentric orbit, θ̇² on a
-    /// circular one (whose θ̈ is the 0 it starts with).
+    /// Keeps the orbit's terms at a sample: θ̈ and μ/R³ from θ on an eccentric orbit, θ̇² and
+    /// no θ̈ on a circular one.
     fn sense_orbit(&mut self, rate_radps: T, true_anomaly_rad: T) {
-        match &self.eccentric {
-            Some(o) => {
-                self.orbit = OrbitTerms {
-                    rate_radps,
-                    accel_radps2: o.true_anomaly_accel_radps2(true_anomaly_rad),
-                    gravity_gradient_per_s2: o.gravity_gradient_per_s2(true_anomaly_rad),
-                }
-            }
-            None => {
-                self.orbit.rate_radps = rate_radps;
-                self.orbit.gravity_gradient_per_s2 = rate_radps * rate_radps;
-            }
-        }
+        self.orbit = match &self.eccentric {
+            Some(o) => OrbitTerms::new(
+                rate_radps,
+                o.true_anomaly_accel_radps2(true_anomaly_rad),
+                o.gravity_gradient_per_s2(true_anomaly_rad),
+            ),
+            None => OrbitTerms::circular(rate_radps),
+        };
     }
 
-    /// The drive of the `k`-th period since the last step: the last step's command, its length
-    /// advanced by k periods of it; the rate measured over the period when the encoder gave
-    /// one (taken as the period's mean: the drive's rate at mid-period, so its start rate is
-    /// the mean less half the period's commanded change). `None` without a command yet
-    /// (the estimate is then dropped: nothing says how the reel moved).
-    fn drive(&self, k: u32, reel_rate_mps: Option<T>) -> Option<Drive<T>> {
-        let (c, o) = (self.commanded?, self.orbit);
+    /// The drive of the `k`-th period since the last step: the last step's command `c`, its
+    /// length advanced by k periods of it; the rate measured over the period when the encoder
+    /// gave one (taken as the period's mean: the drive's rate at mid-period, so its start rate
+    /// is the mean less half the period's commanded change).
+    fn drive(
+        &self,
+        c: &Commanded<T>,
+        orbit: OrbitTerms<T>,
+        k: u32,
+        reel_rate_mps: Option<T>,
+    ) -> Drive<T> {
         let h = self.filter.config().period_s;
         let rate_mps = match reel_rate_mps {
             Some(mean) => mean - T::from_f64(0.5) * c.accel_mps2 * h,
             None => c.rate_mps,
         };
-        Some(Drive {
+        Drive {
             length_m: c.length_m + c.rate_mps * T::from_u32(k) * h,
             rate_mps,
             accel_mps2: c.accel_mps2,
-            orbit_rate_radps: o.rate_radps,
-            orbit_accel_radps2: o.accel_radps2,
-            gravity_gradient_per_s2: o.gravity_gradient_per_s2,
             mu3: c.mu3,
-        })
+            orbit,
+        }
     }
 }
 
@@ -281,46 +276,64 @@ mod tests {
         let mut circular = Estimation::new(&cfg, &Orbit::circular(7_078_000.0)).unwrap();
         let n = 1.06e-3;
         circular.sense_orbit(n, 2.0);
-        let t = circular.orbit;
-        assert_eq!(t.rate_radps, n);
-        assert_eq!(t.accel_radps2.to_bits(), 0.0_f64.to_bits());
-        assert_eq!(t.gravity_gradient_per_s2, n * n);
+        let t = circular.orbit.unwrap();
+        assert_eq!(t.rate_radps(), n);
+        assert_eq!(t.accel_radps2().to_bits(), 0.0_f64.to_bits());
+        assert_eq!(t.gravity_gradient_per_s2(), n * n);
         let orbit = Orbit::elliptic(7_078_000.0, 0.1);
         let mut eccentric = Estimation::new(&cfg, &orbit).unwrap();
         let theta = 2.0;
         eccentric.sense_orbit(n, theta);
-        let t = eccentric.orbit;
-        assert_eq!(t.rate_radps, n);
-        assert_eq!(t.accel_radps2, orbit.true_anomaly_accel_radps2(theta));
+        let t = eccentric.orbit.unwrap();
+        assert_eq!(t.rate_radps(), n);
+        assert_eq!(t.accel_radps2(), orbit.true_anomaly_accel_radps2(theta));
         assert_eq!(
-            t.gravity_gradient_per_s2,
+            t.gravity_gradient_per_s2(),
             orbit.gravity_gradient_per_s2(theta)
         );
-        assert!(t.accel_radps2 != 0.0);
+        assert!(t.accel_radps2() != 0.0);
+    }
+
+    #[test]
+    fn refused_orbit_terms_drop_the_estimate_as_a_refused_drive() {
+        let cfg = estimator::Config::<f64>::paper();
+        let mut e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0)).unwrap();
+        let c = Commanded {
+            length_m: 100.0,
+            rate_mps: 2.0,
+            accel_mps2: 0.0,
+            mu3: 0.01,
+        };
+        e.end_step(c);
+        let (verdict, event) = e.step(0, Some((1.06e-3, 0.0, None)), Some(-0.5));
+        assert!(matches!(verdict, Estimated::Usable(..)));
+        assert_eq!(event, None);
+        // An orbit rate the drive does not admit: the estimate is lost, the next α restarts it.
+        let (_, event) = e.step(1, Some((0.5, 0.0, None)), None);
+        assert_eq!(event, Some(EventKind::EstimateLost));
+        assert!(e.estimate().is_none());
     }
 
     #[test]
     fn the_drive_is_the_last_command_or_the_measured_mean_rate() {
         let cfg = estimator::Config::<f64>::paper();
-        let mut e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0)).unwrap();
-        assert_eq!(e.drive(0, None), None);
-        e.sense_orbit(1.06e-3, 0.0);
+        let e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0)).unwrap();
+        let orbit = OrbitTerms::circular(1.06e-3).unwrap();
         let c = Commanded {
             length_m: 100.0,
             rate_mps: 2.0,
             accel_mps2: 0.1,
             mu3: 0.01,
         };
-        assert_eq!(e.end_step(c), None);
-        let d = e.drive(0, None).unwrap();
+        let d = e.drive(&c, orbit, 0, None);
         assert_eq!(
             (d.length_m, d.rate_mps, d.accel_mps2, d.mu3),
             (100.0, 2.0, 0.1, 0.01)
         );
         // The encoder's mean rate over the period is the drive's rate at mid-period.
-        let d = e.drive(0, Some(2.2)).unwrap();
+        let d = e.drive(&c, orbit, 0, Some(2.2));
         assert_eq!(d.rate_mps + 0.5 * d.accel_mps2 * 1.0, 2.2);
         // The k-th period of a gap starts k periods of the command further on.
-        assert_eq!(e.drive(3, None).unwrap().length_m, 106.0);
+        assert_eq!(e.drive(&c, orbit, 3, None).length_m, 106.0);
     }
 }

@@ -156,6 +156,10 @@ pub const MAX_ALPHA_RATE_RADPS: f64 = 1.0;
 /// Earth); its square bounds |θ̈| and μ/R³, which keeps 3(μ/R³)h² small for the discretisation.
 pub const MAX_ORBIT_RATE_RADPS: f64 = 1e-2;
 
+/// The slowest circular orbit [`OrbitTerms::circular`] admits, rad/s (a year-long orbit is
+/// 2·10⁻⁷ rad/s); its square stays a normal, positive f32.
+pub const MIN_CIRCULAR_ORBIT_RATE_RADPS: f64 = 1e-10;
+
 /// The longest tether a drive may give, m (a thousand kilometres: any real tether).
 pub const MAX_LENGTH_M: f64 = 1e6;
 
@@ -171,14 +175,90 @@ pub struct Drive<T> {
     pub rate_mps: T,
     /// l̈ over the period, m/s² (0 for a rate held over the period).
     pub accel_mps2: T,
-    /// The orbit rate θ̇, rad/s (n on a circular orbit).
-    pub orbit_rate_radps: T,
-    /// The orbit's angular acceleration θ̈, rad/s² (0 on a circular orbit).
-    pub orbit_accel_radps2: T,
-    /// The gravity gradient μ/R³, 1/s² (n² on a circular orbit).
-    pub gravity_gradient_per_s2: T,
     /// μ3 at this length (Eq. 5; 0 for a massless tether).
     pub mu3: T,
+    /// The orbit's θ̇, θ̈ and μ/R³ (checked when they were built).
+    pub orbit: OrbitTerms<T>,
+}
+
+/// The orbit's terms of the libration dynamics: θ̇, θ̈ and μ/R³. They can only be built
+/// checked, so the prediction need not check them again each period: θ̇ in
+/// (0, [`MAX_ORBIT_RATE_RADPS`]], |θ̈| and μ/R³ at most its square, μ/R³ positive.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OrbitTerms<T> {
+    rate_radps: T,
+    accel_radps2: T,
+    gravity_gradient_per_s2: T,
+}
+
+impl<T: Real> OrbitTerms<T> {
+    /// The terms θ̇ (rad/s), θ̈ (rad/s²) and μ/R³ (1/s²) of an orbit at one instant, or the
+    /// first out of range ([`DriveInput::OrbitRate`], [`DriveInput::OrbitAccel`],
+    /// [`DriveInput::GravityGradient`]).
+    pub fn new(
+        rate_radps: T,
+        accel_radps2: T,
+        gravity_gradient_per_s2: T,
+    ) -> Result<Self, DriveError> {
+        let max = T::from_f64(MAX_ORBIT_RATE_RADPS);
+        let refuse = |input, value: T| {
+            Err(DriveError {
+                input,
+                value: value.to_f64(),
+            })
+        };
+        if !(rate_radps > T::ZERO && rate_radps <= max) {
+            return refuse(DriveInput::OrbitRate, rate_radps);
+        }
+        if above_or_nan(accel_radps2.abs(), max * max) {
+            return refuse(DriveInput::OrbitAccel, accel_radps2);
+        }
+        if !(gravity_gradient_per_s2 > T::ZERO && gravity_gradient_per_s2 <= max * max) {
+            return refuse(DriveInput::GravityGradient, gravity_gradient_per_s2);
+        }
+        Ok(Self {
+            rate_radps,
+            accel_radps2,
+            gravity_gradient_per_s2,
+        })
+    }
+
+    /// The terms of a circular orbit of rate n (rad/s): θ̇ = n, θ̈ = 0, μ/R³ = n². Refused
+    /// unless n is in [[`MIN_CIRCULAR_ORBIT_RATE_RADPS`], [`MAX_ORBIT_RATE_RADPS`]] (its
+    /// square is then in range too).
+    pub fn circular(rate_radps: T) -> Result<Self, DriveError> {
+        let (min, max) = (
+            T::from_f64(MIN_CIRCULAR_ORBIT_RATE_RADPS),
+            T::from_f64(MAX_ORBIT_RATE_RADPS),
+        );
+        if rate_radps >= min && rate_radps <= max {
+            Ok(Self {
+                rate_radps,
+                accel_radps2: T::ZERO,
+                gravity_gradient_per_s2: rate_radps * rate_radps,
+            })
+        } else {
+            Err(DriveError {
+                input: DriveInput::OrbitRate,
+                value: rate_radps.to_f64(),
+            })
+        }
+    }
+
+    /// θ̇, rad/s.
+    pub fn rate_radps(&self) -> T {
+        self.rate_radps
+    }
+
+    /// θ̈, rad/s².
+    pub fn accel_radps2(&self) -> T {
+        self.accel_radps2
+    }
+
+    /// μ/R³, 1/s².
+    pub fn gravity_gradient_per_s2(&self) -> T {
+        self.gravity_gradient_per_s2
+    }
 }
 
 /// The input of a [`Drive`] that was refused.
@@ -191,11 +271,11 @@ pub enum DriveInput {
     Rate,
     /// `accel_mps2`: not finite.
     Accel,
-    /// `orbit_rate_radps`: not in (0, [`MAX_ORBIT_RATE_RADPS`]].
+    /// θ̇ ([`OrbitTerms`]): not in (0, [`MAX_ORBIT_RATE_RADPS`]].
     OrbitRate,
-    /// `orbit_accel_radps2`: |θ̈| above [`MAX_ORBIT_RATE_RADPS`]² or not finite.
+    /// θ̈ ([`OrbitTerms`]): |θ̈| above [`MAX_ORBIT_RATE_RADPS`]² or not finite.
     OrbitAccel,
-    /// `gravity_gradient_per_s2`: not in (0, [`MAX_ORBIT_RATE_RADPS`]²].
+    /// μ/R³ ([`OrbitTerms`]): not in (0, [`MAX_ORBIT_RATE_RADPS`]²].
     GravityGradient,
     /// `mu3`: |μ3| > [`MAX_MU3`] or not finite.
     Mu3,
@@ -314,12 +394,11 @@ struct Track<T> {
 /// The libration estimator (see the module docs).
 ///
 /// ```
-/// use tss_reel::estimator::{Config, Drive, Estimator, Measurement};
+/// use tss_reel::estimator::{Config, Drive, Estimator, Measurement, OrbitTerms};
 /// let mut est = Estimator::<f32>::new(Config::paper()).unwrap();
-/// let n = 1.06e-3; // a circular orbit: θ̇ = n, θ̈ = 0, μ/R³ = n²
-/// let drive = Drive { length_m: 9_000.0, rate_mps: 1.0, accel_mps2: 0.0,
-///                     orbit_rate_radps: n, orbit_accel_radps2: 0.0,
-///                     gravity_gradient_per_s2: n * n, mu3: 0.0 };
+/// // A circular orbit: θ̇ = n, θ̈ = 0, μ/R³ = n².
+/// let orbit = OrbitTerms::circular(1.06e-3).unwrap();
+/// let drive = Drive { length_m: 9_000.0, rate_mps: 1.0, accel_mps2: 0.0, mu3: 0.0, orbit };
 /// let out = est.step(&drive, Some(-0.78));
 /// assert_eq!(out.measurement, Measurement::Initialised);
 /// let out = est.step(&drive, Some(-0.78));
@@ -493,32 +572,18 @@ impl<T: Real> Estimator<T> {
     /// The drive's s = (2 + μ3) l̇/l at mid-period, 1/s, or the input at fault.
     ///
     /// The rate and the acceleration need no test of their own: a NaN or an infinity in
-    /// either makes s NaN or infinite, and a finite but absurd one makes |s h| too large.
+    /// either makes s NaN or infinite, and a finite but absurd one makes |s h| too large. The
+    /// orbit's terms were checked when they were built ([`OrbitTerms`]).
     fn stretch(&self, drive: &Drive<T>) -> Result<T, DriveError> {
         let f = T::from_f64;
-        let (l, v, a, n, mu3) = (
-            drive.length_m,
-            drive.rate_mps,
-            drive.accel_mps2,
-            drive.orbit_rate_radps,
-            drive.mu3,
-        );
+        let (l, v, a, mu3) = (drive.length_m, drive.rate_mps, drive.accel_mps2, drive.mu3);
         let h = self.config.period_s;
         let half_h = f(0.5) * h;
         let rate_mid = v + a * half_h;
         let length_mid = l + (v + f(0.5) * a * half_h) * half_h;
         let s = (f(2.0) + mu3) * rate_mid / length_mid;
         let u = s * h;
-        let orbit_max = f(MAX_ORBIT_RATE_RADPS);
-        let gradient = drive.gravity_gradient_per_s2;
-        let inputs_in_range = l > T::ZERO
-            && l <= f(MAX_LENGTH_M)
-            && n > T::ZERO
-            && n <= orbit_max
-            && drive.orbit_accel_radps2.abs() <= orbit_max * orbit_max
-            && gradient > T::ZERO
-            && gradient <= orbit_max * orbit_max
-            && mu3.abs() <= f(MAX_MU3);
+        let inputs_in_range = l > T::ZERO && l <= f(MAX_LENGTH_M) && mu3.abs() <= f(MAX_MU3);
         if inputs_in_range && length_mid > T::ZERO && u.abs() <= f(MAX_STRETCH_PER_PERIOD) {
             Ok(s)
         } else {
@@ -533,12 +598,12 @@ impl<T: Real> Estimator<T> {
         let s = self.stretch(drive).map_err(Prediction::InvalidDrive)?;
         let h = self.config.period_s;
         // 3μ/(2R³), and κ = (3μ/R³) cos 2α̂.
-        let gradient = f(1.5) * drive.gravity_gradient_per_s2;
+        let gradient = f(1.5) * drive.orbit.gravity_gradient_per_s2;
         let (sin2a, cos2a) = t.trig.unwrap_or_else(|| (f(2.0) * t.alpha).sin_cos());
         let stiffness = f(2.0) * gradient * cos2a;
         // Eq. 5b at the estimate: f(x) = (α̇, α̈, 0).
-        let spin = drive.orbit_rate_radps + t.rate;
-        let accel = -spin * s - gradient * sin2a - drive.orbit_accel_radps2 + t.disturbance;
+        let spin = drive.orbit.rate_radps + t.rate;
+        let accel = -spin * s - gradient * sin2a - drive.orbit.accel_radps2 + t.disturbance;
         // Ψ = φ₁(Ah) = I + Ah/2 + (Ah)²/6 + (Ah)³/24 with u = s h and k = κ h², factored on
         // two shared polynomials (exactly the series' terms, regrouped):
         //   c = 1/6 − u/24,   w = 1/2 − u c − k/24,
@@ -629,23 +694,13 @@ fn above_or_nan<T: Real>(v: T, cap: T) -> bool {
 /// Which input of a refused drive is at fault (in the order of [`DriveInput`]), `u` = s h.
 fn refusal<T: Real>(drive: &Drive<T>, u: T) -> DriveError {
     let f = T::from_f64;
-    let (l, n, mu3) = (drive.length_m, drive.orbit_rate_radps, drive.mu3);
+    let (l, mu3) = (drive.length_m, drive.mu3);
     let (input, value) = if !(l > T::ZERO && l <= f(MAX_LENGTH_M)) {
         (DriveInput::Length, l)
     } else if !drive.rate_mps.is_finite() {
         (DriveInput::Rate, drive.rate_mps)
     } else if !drive.accel_mps2.is_finite() {
         (DriveInput::Accel, drive.accel_mps2)
-    } else if !(n > T::ZERO && n <= f(MAX_ORBIT_RATE_RADPS)) {
-        (DriveInput::OrbitRate, n)
-    } else if drive.orbit_accel_radps2.is_nan()
-        || drive.orbit_accel_radps2.abs() > f(MAX_ORBIT_RATE_RADPS).sq()
-    {
-        (DriveInput::OrbitAccel, drive.orbit_accel_radps2)
-    } else if !(drive.gravity_gradient_per_s2 > T::ZERO
-        && drive.gravity_gradient_per_s2 <= f(MAX_ORBIT_RATE_RADPS).sq())
-    {
-        (DriveInput::GravityGradient, drive.gravity_gradient_per_s2)
     } else if mu3.is_nan() || mu3.abs() > f(MAX_MU3) {
         (DriveInput::Mu3, mu3)
     } else {

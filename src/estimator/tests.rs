@@ -10,10 +10,8 @@ fn drive(length_m: f64, rate_mps: f64) -> Drive<f64> {
         length_m,
         rate_mps,
         accel_mps2: 0.0,
-        orbit_rate_radps: N,
-        orbit_accel_radps2: 0.0,
-        gravity_gradient_per_s2: N * N,
         mu3: 0.0,
+        orbit: OrbitTerms::circular(N).unwrap(),
     }
 }
 
@@ -55,6 +53,58 @@ fn every_invalid_parameter_is_named() {
 }
 
 #[test]
+fn orbit_terms_out_of_range_are_refused_when_built() {
+    let refused = |r: Result<OrbitTerms<f64>, DriveError>| r.unwrap_err().input;
+    let max = MAX_ORBIT_RATE_RADPS;
+    assert_eq!(
+        refused(OrbitTerms::new(0.0, 0.0, N * N)),
+        DriveInput::OrbitRate
+    );
+    assert_eq!(
+        refused(OrbitTerms::new(2.0 * max, 0.0, N * N)),
+        DriveInput::OrbitRate
+    );
+    assert_eq!(
+        refused(OrbitTerms::new(f64::NAN, 0.0, N * N)),
+        DriveInput::OrbitRate
+    );
+    assert_eq!(
+        refused(OrbitTerms::new(N, f64::NAN, N * N)),
+        DriveInput::OrbitAccel
+    );
+    assert_eq!(
+        refused(OrbitTerms::new(N, 2.0 * max * max, N * N)),
+        DriveInput::OrbitAccel
+    );
+    assert_eq!(
+        refused(OrbitTerms::new(N, 0.0, -1e-6)),
+        DriveInput::GravityGradient
+    );
+    assert_eq!(
+        refused(OrbitTerms::new(N, 0.0, 0.0)),
+        DriveInput::GravityGradient
+    );
+    assert_eq!(
+        refused(OrbitTerms::new(N, 0.0, f64::NAN)),
+        DriveInput::GravityGradient
+    );
+    for n in [0.0, -N, 1e-11, 2.0 * max, f64::NAN, f64::INFINITY] {
+        assert_eq!(
+            refused(OrbitTerms::circular(n)),
+            DriveInput::OrbitRate,
+            "{n}"
+        );
+    }
+    // The slowest circular orbit admitted still has a positive μ/R³ in f32, and is a valid
+    // general orbit.
+    let slow = OrbitTerms::circular(MIN_CIRCULAR_ORBIT_RATE_RADPS as f32).unwrap();
+    assert!(slow.gravity_gradient_per_s2() > 0.0);
+    let t = OrbitTerms::circular(N).unwrap();
+    assert_eq!(OrbitTerms::new(N, 0.0, N * N), Ok(t));
+    assert_eq!(OrbitTerms::circular(max).map(|t| t.rate_radps()), Ok(max));
+}
+
+#[test]
 fn invalid_drive_inputs_are_typed_and_drop_the_estimate() {
     let good = drive(9_000.0, 1.0);
     let cases = [
@@ -78,27 +128,6 @@ fn invalid_drive_inputs_are_typed_and_drop_the_estimate() {
                 ..good
             },
             DriveInput::Accel,
-        ),
-        (
-            Drive {
-                orbit_rate_radps: 0.0,
-                ..good
-            },
-            DriveInput::OrbitRate,
-        ),
-        (
-            Drive {
-                orbit_accel_radps2: f64::NAN,
-                ..good
-            },
-            DriveInput::OrbitAccel,
-        ),
-        (
-            Drive {
-                gravity_gradient_per_s2: -1e-6,
-                ..good
-            },
-            DriveInput::GravityGradient,
         ),
         (Drive { mu3: -3.0, ..good }, DriveInput::Mu3),
         (
@@ -412,10 +441,8 @@ fn lent_trigonometry_is_used_only_for_the_alpha_it_was_computed_for() {
         length_m: 9_000.0_f32,
         rate_mps: 1.0,
         accel_mps2: 0.0,
-        orbit_rate_radps: N as f32,
-        orbit_accel_radps2: 0.0,
-        gravity_gradient_per_s2: (N * N) as f32,
         mu3: 0.0,
+        orbit: OrbitTerms::circular(N as f32).unwrap(),
     };
     let mut own = Estimator::new(Config::<f32>::paper()).unwrap();
     own.step(&d32, Some(-0.7));

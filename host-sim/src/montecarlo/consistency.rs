@@ -30,7 +30,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use tss_reel::controller::{Controller, Input, Output, RateSource};
-use tss_reel::estimator::{ConfigError, Drive, Estimate, Estimator, Measurement};
+use tss_reel::estimator::{ConfigError, Drive, Estimate, Estimator, Measurement, OrbitTerms};
 use tss_reel::mass::MassModel;
 use tss_reel::Real;
 
@@ -133,9 +133,7 @@ impl Shadow {
             length_m,
             rate_mps,
             accel_mps2: 0.0,
-            orbit_rate_radps: n,
-            orbit_accel_radps2: 0.0,
-            gravity_gradient_per_s2: n * n,
+            orbit: OrbitTerms::circular(n).expect("the monitor accepted θ̇ in range"),
             mu3,
         }
     }
