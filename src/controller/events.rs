@@ -71,12 +71,12 @@ impl EventQueue {
 
     /// Appends `e`; when the queue is full the oldest unread event makes room for it.
     pub(super) fn push(&mut self, e: Event) {
-        if self.queue.is_full() {
+        if let Err(e) = self.queue.push_back(e) {
             self.queue.pop_front();
             self.dropped = self.dropped.saturating_add(1);
+            // Room was made above: the push cannot fail.
+            let _ = self.queue.push_back(e);
         }
-        // Room was made above: the push cannot fail.
-        let _ = self.queue.push_back(e);
     }
 
     /// Appends the event of `kind` at `tick`, if there is one.
