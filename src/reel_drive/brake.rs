@@ -56,14 +56,15 @@ impl SpeedLoop {
     /// `tick` (the drum was held until now) and the observer of the implied tension; leaving
     /// `Engaged` forgets where the brake held the drum. At rest means the command and the
     /// measured speed ~0; a tick without a measured speed (`counted` false) neither advances
-    /// nor restarts the rest count. `tension_n` is the tension the feed-forward uses.
+    /// nor restarts the rest count. `tether_nm` is the torque of the tension the feed-forward
+    /// uses (T r).
     pub(super) fn advance_brake(
         &mut self,
         tick: u32,
         gap_ticks: u32,
         speed_mps: f32,
         counted: bool,
-        tension_n: f32,
+        tether_nm: f32,
     ) {
         self.brake = match self.brake {
             Brake::Tripped(_) | Brake::MotorHold => return,
@@ -78,7 +79,6 @@ impl SpeedLoop {
             Brake::Releasing { ticks_left } if ticks_left <= gap_ticks => {
                 // The ramp is from rest: the brake was not free at the command.
                 self.ramp.start_tick = tick;
-                let tether_nm = tension_n * self.cfg.geometry.drum_radius_m;
                 self.checks.start_observer(speed_mps, tether_nm);
                 Brake::Released { rest_ticks: 0 }
             }

@@ -479,8 +479,11 @@ impl SpeedLoop {
         } else {
             0.0
         };
+        // Its torque at the drum, T r, N m (the feed-forward's, the observer's start, the
+        // judgement's).
+        let tether_nm = tension_n * self.cfg.geometry.drum_radius_m;
 
-        self.advance_brake(tick, gap_ticks, speed_mps, counted, tension_n);
+        self.advance_brake(tick, gap_ticks, speed_mps, counted, tether_nm);
 
         // The torque: PI + feed-forward with the brake free (toward rest while the motor holds
         // a slipping brake), with the checks of a driven drum; while it lifts, the motor takes
@@ -489,7 +492,7 @@ impl SpeedLoop {
             Brake::Released { rest_ticks } => {
                 let (ref_mps, ref_accel_mps2) = self.reference_at(tick);
                 let torque_nm =
-                    self.speed_law(ref_mps, ref_accel_mps2, gap_ticks, speed_mps, tension_n);
+                    self.speed_law(ref_mps, ref_accel_mps2, gap_ticks, speed_mps, tether_nm);
                 let drive = self.driven(ref_mps, ref_accel_mps2, torque_nm);
                 if !counted {
                     // No measured motion: the checks neither count this tick nor clear.
@@ -500,7 +503,7 @@ impl SpeedLoop {
                     self.stall_ticks = 0;
                     drive
                 } else {
-                    match self.driven_checks(gap_ticks, speed_mps, &drive, tension_n, &mut faults) {
+                    match self.driven_checks(gap_ticks, speed_mps, &drive, tether_nm, &mut faults) {
                         Some(fault) => self.trip_driven(fault, &mut faults),
                         None => drive,
                     }
@@ -511,12 +514,12 @@ impl SpeedLoop {
                 // trips the motor here.
                 faults.insert(DriveFault::BrakeSlip);
                 self.stall_ticks = 0;
-                let torque_nm = self.speed_law(0.0, 0.0, gap_ticks, speed_mps, tension_n);
+                let torque_nm = self.speed_law(0.0, 0.0, gap_ticks, speed_mps, tether_nm);
                 self.driven(0.0, 0.0, torque_nm)
             }
             Brake::Releasing { .. } => {
                 self.stall_ticks = 0;
-                self.driven(0.0, 0.0, self.tension_torque_nm(tension_n))
+                self.driven(0.0, 0.0, -tether_nm)
             }
             Brake::Engaged => {
                 self.stall_ticks = 0;
@@ -636,20 +639,19 @@ impl SpeedLoop {
     }
 
     /// The brake free, not at rest, the speed measured: the stall, the implied tension and the
-    /// pinned integral; the fault that trips the drive, if any. `tension_n` is the tension the
-    /// feed-forward used.
+    /// pinned integral; the fault that trips the drive, if any. `used_nm` is the torque of the
+    /// tension the feed-forward used (T_ff r).
     fn driven_checks(
         &mut self,
         gap_ticks: u32,
         speed_mps: f32,
         drive: &Drive,
-        tension_n: f32,
+        used_nm: f32,
         faults: &mut DriveFaults,
     ) -> Option<DriveFault> {
         if self.count_stall(gap_ticks, speed_mps, drive.duty, drive.saturated) {
             return Some(DriveFault::MotorStall);
         }
-        let used_nm = tension_n * self.cfg.geometry.drum_radius_m;
         // The loop at its limit: the duty saturated, or the integral at its clamp.
         let at_limit = drive.saturated || self.integral_nm.abs() >= self.cfg.max_torque_nm;
         match self
@@ -679,16 +681,17 @@ impl SpeedLoop {
 
     /// PI + feed-forward toward the reference `ref_mps`, `ref_accel_mps2` (see the module
     /// docs), with conditional integration: the integral does not grow in the direction that
-    /// held the last tick's duty in saturation. Steps the observer of the implied tension (`reel_drive/checks.rs`: the motor
-    /// applied the last step's duty since; the model's friction is the feed-forward's).
-    /// Returns the torque, N m.
+    /// held the last tick's duty in saturation; `tether_nm` is the tension's torque the
+    /// feed-forward takes (T r). Steps the observer of the implied tension
+    /// (`reel_drive/checks.rs`: the motor applied the last step's duty since; the model's
+    /// friction is the feed-forward's). Returns the torque, N m.
     fn speed_law(
         &mut self,
         ref_mps: f32,
         ref_accel_mps2: f32,
         gap_ticks: u32,
         speed_mps: f32,
-        tension_n: f32,
+        tether_nm: f32,
     ) -> f32 {
         let d = &self.derived;
         let gap = gap_ticks as f32;
@@ -711,7 +714,7 @@ impl SpeedLoop {
         self.cfg.gains.kp_nm_per_mps * error_mps
             + self.integral_nm
             + d.inertia_per_radius * ref_accel_mps2
-            + self.tension_torque_nm(tension_n)
+            - tether_nm
             + friction_nm
     }
 
