@@ -79,7 +79,11 @@ impl SpeedLoop {
             Brake::Releasing { ticks_left } if ticks_left <= gap_ticks => {
                 // The ramp is from rest: the brake was not free at the command.
                 self.ramp.start_tick = tick;
-                self.checks.start_observer(speed_mps, tether_nm);
+                self.checks.start_observer(
+                    speed_mps,
+                    tether_nm,
+                    self.derived.observer_lag_mps_per_nm,
+                );
                 Brake::Released { rest_ticks: 0 }
             }
             Brake::Releasing { ticks_left } => Brake::Releasing {

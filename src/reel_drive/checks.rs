@@ -19,8 +19,9 @@
 //! reference the drum follows (the speed loop keeps the two close; where they part, as in a
 //! runaway, the friction is the smaller term by far). T̂ = D̂ / r is the implied tension. It
 //! restarts at each release of the brake from the tension the feed-forward uses (no
-//! transient), and is judged only while the drum is driven (released, not at rest, with a
-//! measured speed), against that tension T_ff:
+//! transient: v̂ starts D̂ / (K J / r) below the measured speed), and is judged only while
+//! the drum is driven (released, not at rest, with a measured speed), against that tension
+//! T_ff:
 //!
 //! - |T̂ − T_ff| within `tension_mismatch_n`: they agree (and T̂, within the tolerance of a
 //!   tension inside [min, max], is a plausible one);
@@ -87,9 +88,10 @@ impl CrossChecks {
     };
 
     /// Restarts the observer at a release: the drum's speed as measured, the tether's torque
-    /// as the feed-forward takes it.
-    pub(super) fn start_observer(&mut self, speed_mps: f32, tether_nm: f32) {
-        self.predicted_speed_mps = speed_mps;
+    /// as the feed-forward takes it. D̂ = K (J / r) (v − v̂) holds that torque when the model's
+    /// speed lags the measured one by D̂ / (K J / r); `mps_per_nm` = r / (K J).
+    pub(super) fn start_observer(&mut self, speed_mps: f32, tether_nm: f32, mps_per_nm: f32) {
+        self.predicted_speed_mps = speed_mps - tether_nm * mps_per_nm;
         self.implied_tether_nm = tether_nm;
         self.unanswered_ticks = 0;
         self.mismatch_ticks = 0;
@@ -167,7 +169,7 @@ mod tests {
     fn the_observer_finds_the_torque_the_model_misses() {
         let (j_per_r, dt, k) = (0.5_f32, 1e-3_f32, 20.0_f32);
         let mut c = CrossChecks::START;
-        c.start_observer(0.0, 0.0);
+        c.start_observer(0.0, 0.0, 1.0 / (k * j_per_r));
         let mut v = 0.0_f32;
         for _ in 0..250 {
             v += dt * (-1.0 + 2.0) / j_per_r;
@@ -179,6 +181,23 @@ mod tests {
             "{}",
             c.implied_tether_nm
         );
+    }
+
+    /// Restarted at a tether torque of 2 N m that the motor holds (−2 N m), the drum still:
+    /// the observer goes on finding the 2 N m, without a transient.
+    #[test]
+    fn the_observer_restarts_at_the_torque_it_is_given() {
+        let (j_per_r, dt, k) = (0.5_f32, 1e-3_f32, 20.0_f32);
+        let mut c = CrossChecks::START;
+        c.start_observer(0.3, 2.0, 1.0 / (k * j_per_r));
+        for _ in 0..10 {
+            c.observe(0.3, -2.0, dt / j_per_r, k * j_per_r);
+            assert!(
+                (c.implied_tether_nm - 2.0).abs() < 1e-4,
+                "{}",
+                c.implied_tether_nm
+            );
+        }
     }
 
     #[test]

@@ -207,6 +207,8 @@ struct Derived {
     speed_per_impulse: f32,
     /// K J / r: the observer's gain, N m per m/s.
     observer_gain_nm_per_mps: f32,
+    /// r / (K J): the observer's speed lag per N m it finds, m/s.
+    observer_lag_mps_per_nm: f32,
     /// The implied tension's limits.
     judge: TensionJudge,
     /// [`FaultLimits::brake_slip_m`] in whole counts.
@@ -271,6 +273,7 @@ impl SpeedLoop {
             per_max_torque: 1.0 / cfg.max_torque_nm,
             speed_per_impulse: cfg.tick_s() * r / cfg.drum.inertia_kgm2,
             observer_gain_nm_per_mps: f.observer_bandwidth_radps * cfg.drum.inertia_kgm2 / r,
+            observer_lag_mps_per_nm: r / (f.observer_bandwidth_radps * cfg.drum.inertia_kgm2),
             judge: TensionJudge {
                 lowest_nm: (f.min_tension_n - f.tension_mismatch_n) * r,
                 highest_nm: (f.max_tension_n + f.tension_mismatch_n) * r,
