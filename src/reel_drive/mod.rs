@@ -687,7 +687,10 @@ impl SpeedLoop {
     /// held the last tick's duty in saturation; `tether_nm` is the tension's torque the
     /// feed-forward takes (T r). Steps the observer of the implied tension
     /// (`reel_drive/checks.rs`: the motor applied the last step's duty since; the model's
-    /// friction is the feed-forward's). Returns the torque, N m.
+    /// friction is the feed-forward's). Returns the torque, N m. Inlined: out of line, the
+    /// call and its six arguments cost every driven step about 7 instructions
+    /// (`TSS_BENCH_EXACT=1 scripts/bench-target`).
+    #[inline]
     fn speed_law(
         &mut self,
         ref_mps: f32,
