@@ -687,9 +687,15 @@ fn spool_end_holds_with_a_lagging_drive() {
             "reel.max_accel_mps2=0.1",
         ],
     );
-    let overrun = h.spool_overrun.expect("the unprotected drive runs off the spool");
+    let overrun = h
+        .spool_overrun
+        .expect("the unprotected drive runs off the spool");
     assert!(overrun.length_m > overrun.spool_m, "{overrun:?}");
-    assert!(h.faults.max_excursion_m > 0.0, "{}", h.faults.max_excursion_m);
+    assert!(
+        h.faults.max_excursion_m > 0.0,
+        "{}",
+        h.faults.max_excursion_m
+    );
 }
 
 /// TSS-1R at short length: a 40 s dropout at t = 40 s (l ≈ 5 m) puts the reel in safe hold;

@@ -666,64 +666,87 @@ fn the_loop_flies_the_elastic_plant() {
     assert!(last.tension_n > 0.0 && e.tension_tip_n > 0.0);
 }
 
+/// The mean paid-out length and range of paper-elastic with `segment_m` segments, over Table 1's
+/// hour of each keep (7–8 h, 14–15 h): `[(length, range); 2]`, m.
+fn keep_hour_means(segment_m: f64) -> [(f64, f64); 2] {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper-elastic.toml");
+    let sets = [format!("tether.segment_length_m={segment_m}")];
+    let sc = Scenario::load(&path, &sets).unwrap();
+    let h = tss_sim::sim::run(&sc, &[], &mut |_| {}).unwrap();
+    assert_eq!(h.elastic.len(), h.samples.len());
+    [(25_200.0, 28_800.0), (50_400.0, 54_000.0)].map(|(from, to)| {
+        let hour: Vec<(f64, f64)> = h
+            .samples
+            .iter()
+            .zip(&h.elastic)
+            .filter(|(x, _)| x.t_s >= from && x.t_s <= to)
+            .map(|(x, e)| (x.length_m, e.range_m))
+            .collect();
+        assert!(hour.len() > 300, "{} samples", hour.len());
+        let n = hour.len() as f64;
+        (
+            hour.iter().map(|x| x.0).sum::<f64>() / n,
+            hour.iter().map(|x| x.1).sum::<f64>() / n,
+        )
+    })
+}
+
+/// paper-elastic refined (1400, 700 and 350 m segments: 20, 41 and 82 beads at 30 km).
+fn refined_keep_hour_means() -> [[(f64, f64); 2]; 3] {
+    let means = [1_400.0, 700.0, 350.0].map(keep_hour_means);
+    for (stage, name) in ["30 km", "2 km"].iter().enumerate() {
+        println!(
+            "{name} keep, mean over its hour: length {:.3} / {:.3} / {:.3} m, range {:.3} / {:.3} / {:.3} m (20 / 41 / 82 beads at 30 km)",
+            means[0][stage].0,
+            means[1][stage].0,
+            means[2][stage].0,
+            means[0][stage].1,
+            means[1][stage].1,
+            means[2][stage].1
+        );
+    }
+    means
+}
+
 /// Verification 5 (long: three 20-h missions, about a minute in release; `cargo test --release
-/// -p tss-sim --test truth_model -- --ignored`): refining the beads of paper-elastic (1400, 700
-/// and 350 m segments: 20, 41 and 82 beads at 30 km) converges the 30-km keep's mean length, and
-/// leaves the 2-km keep's where it is.
-///
-/// What converges: both keeps are limit cycles, not equilibria (stage 1: the bounce and string
-/// modes the deploy excites, ±9 m of length; stage 2: a slack–snap cycle of the sub-satellite):
-/// the length at one instant depends on the cycle's phase, which is not a converged quantity,
-/// and a mean of a few samples aliases the ≈ 108 s bounce. The mean over the keep's last hour
-/// (Table 1's hour, every history sample) is the converged quantity. Measured: stage 1
-/// 30 007.4, 30 013.0, 30 010.3 m, so the change halves with each halving of the segment (5.6 m,
-/// then 2.7 m: 2e-4 and 1e-4 of 30 km, against the 30 m static stretch at 10 N); stage 2, where
-/// no bead is left (the tether is one spring), 2 004.7, 2 004.4, 2 003.7 m: the retrieval's
-/// history alone.
+/// -p tss-sim --test truth_model -- --ignored`): refining the beads of paper-elastic changes
+/// nothing the controller holds. paper-elastic flies the flight configuration with the tension
+/// loop (docs/equations.md §17): the keeps are held equilibria, so each keep's mean paid-out
+/// length over Table 1's hour stays within 0.1 m whatever the plant's discretisation, and at
+/// 2 km, where no bead is left (the tether is one spring), so does the range between the end
+/// bodies.
 #[test]
 #[ignore = "three 20-hour missions: about a minute in release, far longer in the test profile"]
 fn refining_the_beads_converges_the_keeps_mean_length() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper-elastic.toml");
-    let fly = |segment_m: f64| {
-        let sets = [format!("tether.segment_length_m={segment_m}")];
-        let sc = Scenario::load(&path, &sets).unwrap();
-        let h = tss_sim::sim::run(&sc, &[], &mut |_| {}).unwrap();
-        // The mean length over Table 1's hour of each keep (7–8 h, 14–15 h).
-        [(25_200.0, 28_800.0), (50_400.0, 54_000.0)].map(|(from, to)| {
-            let hour: Vec<f64> = h
-                .samples
-                .iter()
-                .filter(|x| x.t_s >= from && x.t_s <= to)
-                .map(|x| x.length_m)
-                .collect();
-            assert!(hour.len() > 300, "{} samples", hour.len());
-            hour.iter().sum::<f64>() / hour.len() as f64
-        })
-    };
-    let means = [fly(1_400.0), fly(700.0), fly(350.0)];
-    let change = |stage: usize, k: usize| (means[k][stage] - means[k + 1][stage]).abs();
-    for (stage, name) in ["30 km", "2 km"].iter().enumerate() {
-        println!(
-            "{name} keep, mean over its hour: {:.3} / {:.3} / {:.3} m (20 / 41 / 82 beads at 30 km)",
-            means[0][stage], means[1][stage], means[2][stage]
-        );
+    let means = refined_keep_hour_means();
+    for stage in 0..2 {
+        for k in 0..2 {
+            let d = (means[k][stage].0 - means[k + 1][stage].0).abs();
+            assert!(d < 0.1, "stage {}: held length moved by {d} m", stage + 1);
+        }
     }
-    // Stage 1: the refinement converges (each change smaller than the last) and the coarse
-    // grid is within 10 m (3e-4 of the length, a third of the static stretch).
+    for k in 0..2 {
+        let d = (means[k][1].1 - means[k + 1][1].1).abs();
+        assert!(d < 0.1, "2 km: range moved by {d} m");
+    }
+}
+
+/// The 30-km keep's mean range (the paid-out length stretched by the tension and shortened by
+/// the bowing) should converge with the beads: each change smaller than the last (or below
+/// 5 cm), the coarse grid within 10 m. Open (docs/truth-model.md §3): measured 30 030.588 /
+/// 30 030.592 / 30 018.442 m with 20 / 41 / 82 beads, the finest grid 12 m shorter.
+#[test]
+#[ignore = "open: the 82-bead tether's range at 30 km differs by 12 m (docs/truth-model.md §3)"]
+fn refining_the_beads_converges_the_30_km_keeps_range() {
+    let means = refined_keep_hour_means();
+    let change = |k: usize| (means[k][0].1 - means[k + 1][0].1).abs();
     assert!(
-        change(0, 1) < change(0, 0),
+        change(1) < change(0) || change(1) < 0.05,
         "{} then {}",
-        change(0, 0),
-        change(0, 1)
+        change(0),
+        change(1)
     );
-    assert!(change(0, 0) < 10.0, "{}", change(0, 0));
-    // Stage 2: no bead at 2 km; the mean moves by less than 2 m (0.1 %).
-    assert!(
-        change(1, 0) < 2.0 && change(1, 1) < 2.0,
-        "{} {}",
-        change(1, 0),
-        change(1, 1)
-    );
+    assert!(change(0) < 10.0, "{}", change(0));
 }
 
 /// Convergence in the step (long: three 20-h missions, a few seconds each in release; `cargo
