@@ -42,7 +42,7 @@ use crate::montecarlo::{Campaign, Outcome};
 use crate::output::OutputSet;
 use crate::plots::{check_font, draw_error, write_png_and_svg, Figure, FONT};
 use crate::report::summarize;
-use crate::scenario::{LawName, Scenario};
+use crate::scenario::{LawName, PlantModel, Scenario};
 use crate::table1::probe_times_for;
 use crate::usage::{quiet, UsageError};
 
@@ -55,12 +55,9 @@ pub struct CompareArgs {
     /// Scenario file (TOML), e.g. scenarios/seds2.toml.
     pub scenario: PathBuf,
     /// The laws to fly, comma-separated: paper (without the tension loop), paper+loop (with
-    /// the scenario's `[tension_loop]`), rupp, tracking.
-    #[arg(
-        long,
-        value_delimiter = ',',
-        default_value = "paper,paper+loop,rupp,tracking"
-    )]
+    /// the scenario's `[tension_loop]`), rupp, tracking [default: all of them; on the rigid
+    /// plant all but paper+loop, whose loop needs an elastic tether].
+    #[arg(long, value_delimiter = ',')]
     pub laws: Vec<String>,
     /// Fly each law on this many runs of the scenario's `[montecarlo]` campaign (same seeds for
     /// every law) besides the nominal run.
@@ -399,6 +396,17 @@ pub fn parse_laws(names: &[String]) -> Result<Vec<Contender>, UsageError> {
     Ok(laws)
 }
 
+/// The laws `compare` flies when none are named: every contender the scenario's plant can fly
+/// (the tension loop damps an elastic tether, and is unstable on the rigid rod:
+/// docs/equations.md §17.3).
+pub fn default_laws(sc: &Scenario) -> Vec<Contender> {
+    let elastic = sc.plant.model == PlantModel::Elastic;
+    Contender::ALL
+        .into_iter()
+        .filter(|c| elastic || !c.tension_loop)
+        .collect()
+}
+
 /// `sc` flown by `law`, validated (a tension law on the elastic plant needs the motor reel).
 fn with_law(sc: &Scenario, law: Contender) -> Result<Scenario, UsageError> {
     let mut s = sc.clone();
@@ -419,13 +427,17 @@ fn with_law(sc: &Scenario, law: Contender) -> Result<Scenario, UsageError> {
 
 /// `tss-sim compare`.
 pub fn compare(args: &CompareArgs) -> anyhow::Result<()> {
-    let laws = parse_laws(&args.laws)?;
+    let sc = Scenario::load(&args.scenario, &args.set)?;
+    let laws = if args.laws.is_empty() {
+        default_laws(&sc)
+    } else {
+        parse_laws(&args.laws)?
+    };
     if let Some(n) = args.runs {
         if n == 0 || n > MAX_RUNS {
             return Err(UsageError(format!("--runs {n}: must be in 1..={MAX_RUNS}")).into());
         }
     }
-    let sc = Scenario::load(&args.scenario, &args.set)?;
     if args.runs.is_some() && sc.montecarlo.dispersion.is_empty() {
         return Err(UsageError(format!(
             "--runs: {} has no [[montecarlo.dispersion]] to disperse",

@@ -719,14 +719,12 @@ fn refined_keep_hour_means() -> [[(f64, f64); 2]; 3] {
 #[ignore = "three 20-hour missions: about a minute in release, far longer in the test profile"]
 fn refining_the_beads_converges_the_keeps_mean_length() {
     let means = refined_keep_hour_means();
-    for stage in 0..2 {
-        for k in 0..2 {
-            let d = (means[k][stage].0 - means[k + 1][stage].0).abs();
+    for pair in means.windows(2) {
+        for (stage, (coarse, fine)) in pair[0].iter().zip(&pair[1]).enumerate() {
+            let d = (coarse.0 - fine.0).abs();
             assert!(d < 0.1, "stage {}: held length moved by {d} m", stage + 1);
         }
-    }
-    for k in 0..2 {
-        let d = (means[k][1].1 - means[k + 1][1].1).abs();
+        let d = (pair[0][1].1 - pair[1][1].1).abs();
         assert!(d < 0.1, "2 km: range moved by {d} m");
     }
 }
