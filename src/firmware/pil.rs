@@ -62,6 +62,8 @@ pub const MAX_SILENT_PERIODS: u32 = 600;
 const MAX_POLLS_PER_WAIT: u32 = 1 << 28;
 
 /// What one wait on the link produced.
+// The parameter table arrives once a run; there is no heap to box it in.
+#[allow(clippy::large_enum_variant)]
 enum Received {
     /// A sample frame for the awaited period (or a later one).
     Sample(Sample),
