@@ -22,7 +22,7 @@ pub fn fnv1a_f32(hash: u32, x: f32) -> u32 {
 }
 
 /// A fingerprint of a controller configuration: FNV-1a over the bit pattern of every field, in
-/// declaration order. The firmware sends it in [`Hello`]; the plant compares it with the
+/// declaration order. The firmware sends it in [`Hello`](super::Hello); the plant compares it with the
 /// configuration its scenario describes, so a PIL run cannot fly a different controller than the
 /// host-linked run it is compared with. Every struct is destructured without `..`: a new field
 /// anywhere in the configuration does not compile until it is added here.

@@ -18,7 +18,7 @@ pub enum Gate {
 /// [`LinkCounters`]. A discarded frame does not use up the period: the receiver keeps waiting
 /// for the right one (so a repeated frame cannot push the receiver ahead of the sender).
 ///
-/// The sender numbers its frames from 0 and its [`End`] frame carries the number after its last
+/// The sender numbers its frames from 0 and its [`End`](super::End) frame carries the number after its last
 /// sample, so frames lost before the first one that arrives and after the last one are counted
 /// as gaps too ([`SampleGate::close`]): the count is exact whichever frames are lost.
 #[derive(Clone, Copy, Debug, Default)]
@@ -81,7 +81,7 @@ impl SampleGate {
         Gate::Accept(sample)
     }
 
-    /// The sender's [`End`] frame, number `end_seq`, closed the run: counts the frames lost
+    /// The sender's [`End`](super::End) frame, number `end_seq`, closed the run: counts the frames lost
     /// after the last one seen (all of them if none arrived).
     pub fn close(&mut self, end_seq: u32, counters: &mut LinkCounters) {
         let gap = end_seq.saturating_sub(self.expected_seq());

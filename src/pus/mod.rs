@@ -10,9 +10,9 @@
 //! # Telecommands (APID [`APID`], PUS-C, with the packet error control CRC-16)
 //!
 //! ```text
-//! TC[8,1]    perform a function        app data: function id u16 (ModeCommand), 2 bytes
-//! TC[9,128]  set the on-board time     app data: mission tick u32, 4 bytes
-//! TC[20,128] load the parameter table  app data: PARAM_WORDS words u32, then their CRC-32
+//! TC\[8,1\]    perform a function        app data: function id u16 (ModeCommand), 2 bytes
+//! TC\[9,128\]  set the on-board time     app data: mission tick u32, 4 bytes
+//! TC\[20,128\] load the parameter table  app data: PARAM_WORDS words u32, then their CRC-32
 //!                                      (ISO-HDLC) u32: 4 × 70 + 4 = 284 bytes
 //! ```
 //!
@@ -48,7 +48,7 @@ pub const MAX_TC_LEN: usize = TC_OVERHEAD_LEN + TABLE_LOAD_LEN;
 const TABLE_CRC: crc::Crc<u32, crc::NoTable> =
     crc::Crc::<u32, crc::NoTable>::new(&crc::CRC_32_ISO_HDLC);
 
-/// The mission modes the on-board computer commands (TC[8,1] function identifiers).
+/// The mission modes the on-board computer commands (TC\[8,1\] function identifiers).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ModeCommand {
@@ -85,11 +85,11 @@ impl ModeCommand {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Telecommand {
-    /// TC[8,1]: change the mission mode.
+    /// TC\[8,1\]: change the mission mode.
     Mode(ModeCommand),
-    /// TC[9,128]: the mission tick of the next control period.
+    /// TC\[9,128\]: the mission tick of the next control period.
     SetTime(u32),
-    /// TC[20,128]: fly this configuration from the next period boundary on (if the core
+    /// TC\[20,128\]: fly this configuration from the next period boundary on (if the core
     /// accepts it; else nothing changes).
     LoadParams(ParamTable),
 }
@@ -129,7 +129,7 @@ pub struct Request {
     pub command: Telecommand,
 }
 
-/// Why the decoder rejected a telecommand: the failure code of its TM[1,2] report
+/// Why the decoder rejected a telecommand: the failure code of its TM\[1,2\] report
 /// (docs/interface.md, failure codes).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -287,11 +287,11 @@ pub fn encode(command: &Telecommand, seq: u16, out: &mut [u8]) -> Option<usize> 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Stage {
-    /// Acceptance: TM[1,1] success, TM[1,2] failure.
+    /// Acceptance: TM\[1,1\] success, TM\[1,2\] failure.
     Acceptance,
-    /// Start of execution: TM[1,3], TM[1,4].
+    /// Start of execution: TM\[1,3\], TM\[1,4\].
     Start,
-    /// Completion of execution: TM[1,7], TM[1,8].
+    /// Completion of execution: TM\[1,7\], TM\[1,8\].
     Completion,
 }
 
@@ -302,7 +302,7 @@ pub const TIME_LEN: usize = 4;
 /// 4, failure code 2 and data 4, packet error control 2.
 pub const MAX_REPORT_LEN: usize = 6 + 7 + TIME_LEN + 4 + 2 + 4 + 2;
 
-/// Writes the TM[1,x] report of `request` at `stage` (`failure`: its reason and 4 bytes of
+/// Writes the TM\[1,x\] report of `request` at `stage` (`failure`: its reason and 4 bytes of
 /// data, e.g. the refused word and rule) into `out`; returns its length. `seq` is the unit's
 /// telemetry sequence count, `tick` the mission tick of the report.
 pub fn verification_report(
