@@ -178,14 +178,18 @@ fn pil_flies_the_flight_configuration_as_the_host_linked_core() {
     let sc = scenario(&FLIGHT_SENSORS);
     let report = assert_pil_is_the_host(&sc, &elf, "agreement");
     assert_eq!(report.ticks, 1801);
-    // What was loaded and flown is the flight configuration, the firmware's built-in one.
+    // What was loaded and flown is the flight configuration (the firmware's built-in one) less
+    // its tension loop, which a rigid rod cannot fly (docs/equations.md §17.3).
+    let rigid_flight = Config {
+        tension_loop: None,
+        ..Config::flight()
+    };
+    assert_eq!(sim::controller_config::<f32>(&sc).unwrap(), rigid_flight);
+    assert_eq!(report.config_digest, link::config_digest(&rigid_flight));
     assert_eq!(
-        sim::controller_config::<f32>(&sc).unwrap(),
-        Config::flight()
+        report.builtin_digest,
+        link::config_digest(&Config::flight())
     );
-    let flight = link::config_digest(&Config::flight());
-    assert_eq!(report.config_digest, flight);
-    assert_eq!(report.builtin_digest, flight);
 }
 
 #[test]
@@ -199,6 +203,10 @@ fn pil_flies_the_flight_configuration_on_the_elastic_plant() {
     let cfg = sim::controller_config::<f32>(&sc).unwrap();
     assert!(matches!(cfg.rate_source, RateSource::Estimator(_)));
     assert!(cfg.masses.tether_density_kg_per_m > 0.0);
+    assert!(
+        cfg.tension_loop.is_some(),
+        "the elastic mission flies the tension loop"
+    );
     let report = assert_pil_is_the_host(&sc, &elf, "elastic");
     assert_eq!(report.config_digest, link::config_digest(&cfg));
     assert_ne!(report.config_digest, report.builtin_digest);
