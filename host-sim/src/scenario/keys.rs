@@ -353,7 +353,7 @@ fn masked(message: &str) -> String {
 
 /// The names of the number keys that have no unit: ratios, coefficients and counts (the last
 /// part of the key; `tss-sim scenario keys` shows "-" for them).
-pub const DIMENSIONLESS_NAMES: [&str; 13] = [
+pub const DIMENSIONLESS_NAMES: [&str; 15] = [
     "eccentricity",
     "courant",
     "drag_coefficient",
@@ -368,6 +368,9 @@ pub const DIMENSIONLESS_NAMES: [&str; 13] = [
     "bias_gain",
     "schedule_rate",
     "retrieve_schedule_rate",
+    // The tension loop's (`[tension_loop]`): a damping ratio and an overshoot allowance.
+    "damping_ratio",
+    "overshoot",
 ];
 
 /// The unit in a key's name, by the naming convention (`_m`, `_mps`, `_rad_per_m`, `_nm`, …);
