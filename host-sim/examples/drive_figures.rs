@@ -130,8 +130,8 @@ fn main() -> anyhow::Result<()> {
 /// The figures of one phase: the difference of the running figures at its end and start.
 fn report(
     phase: PhaseLabel,
-    start: &tss_sim::elastic::reel_drum::DriveFigures,
-    end: &tss_sim::elastic::reel_drum::DriveFigures,
+    start: &tss_sim::plant::DriveFigures,
+    end: &tss_sim::plant::DriveFigures,
 ) {
     let released = end.released_ticks - start.released_ticks;
     let rms = if released == 0 {

@@ -325,7 +325,51 @@ pub struct ElasticObservation {
     /// Number of beads.
     pub beads: usize,
     /// What the flight drive did so far (`reel.model = "flight_drive"` only).
-    pub drive: Option<crate::elastic::reel_drum::DriveFigures>,
+    pub drive: Option<DriveFigures>,
+}
+
+/// What the flight drive did over the periods flown: tracking, saturation, tension, faults.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DriveFigures {
+    /// Inner ticks flown with the brake released (the tracking statistics' population).
+    pub released_ticks: u64,
+    /// Inner ticks flown in all.
+    pub ticks: u64,
+    /// Σ (drum speed − reference)² over the released ticks, (m/s)².
+    pub sum_sq_error: f64,
+    /// Largest |drum speed − reference| over the released ticks, m/s.
+    pub max_error_mps: f64,
+    /// Largest |drum speed − law's command| at the end of a law period (the drive's own
+    /// ramp included), m/s.
+    pub max_period_end_error_mps: f64,
+    /// Ticks with the duty saturated.
+    pub saturated_ticks: u64,
+    /// Least and largest tension at the reel the drive saw, N.
+    pub tension_range_n: (f64, f64),
+    /// Every drive fault seen (bits of `tss_reel::reel_drive::DriveFaults`).
+    pub fault_bits: u16,
+    /// The last tick's duty, −1…1 (filled by `ElasticPlant::drive_figures`).
+    pub duty: f64,
+}
+
+impl DriveFigures {
+    /// RMS of the tracking error over the released ticks, m/s.
+    pub fn rms_error_mps(&self) -> f64 {
+        if self.released_ticks == 0 {
+            0.0
+        } else {
+            (self.sum_sq_error / self.released_ticks as f64).sqrt()
+        }
+    }
+
+    /// The fraction of ticks with the duty saturated.
+    pub fn saturated_fraction(&self) -> f64 {
+        if self.ticks == 0 {
+            0.0
+        } else {
+            self.saturated_ticks as f64 / self.ticks as f64
+        }
+    }
 }
 
 /// One instant of a plant, as the loop records it.

@@ -89,7 +89,7 @@ pub struct Summary {
     /// The last sample.
     pub last: Option<Sample>,
     /// What the flight drive did (`reel.model = "flight_drive"`).
-    pub drive: Option<crate::elastic::reel_drum::DriveFigures>,
+    pub drive: Option<crate::plant::DriveFigures>,
 }
 
 /// First time, interpolated, at which the length crosses into `reached` among `samples` (in

@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use tss_sim::elastic::reel_drum::DriveFigures;
+use tss_sim::plant::DriveFigures;
 use tss_sim::report::summarize;
 use tss_sim::scenario::Scenario;
 

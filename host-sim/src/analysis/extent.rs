@@ -10,8 +10,8 @@ use std::path::PathBuf;
 use serde::Serialize;
 use tss_reel::equilibrium::{self, ECCENTRICITY_LIMIT};
 
-pub use super::ExtentRow;
-use super::{eccentricity, invalid, AnalysisCliError, OutputFormat};
+use super::flags::{eccentricity, invalid, AnalysisCliError, OutputFormat};
+use super::plots::ExtentRow;
 use crate::output::OutputSet;
 
 /// Default spacing of the e grid of Fig. 3 over [0, 0.75].

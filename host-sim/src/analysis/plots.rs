@@ -8,10 +8,33 @@ use std::path::PathBuf;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use serde::Serialize;
 
-use super::ExtentRow;
 use crate::output::OutputSet;
 use crate::plots::{draw_error, png_and_svg, write_png_and_svg, FONT};
+
+/// One row of Fig. 3: the whole-orbit bounds of Eq. 13 at one e.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ExtentRow {
+    /// e.
+    pub eccentricity: f64,
+    /// min_θ Depl(e, θ).
+    pub min_depl: f64,
+    /// θ* of min Depl, rad.
+    pub theta_star_depl_rad: f64,
+    /// θ* of min Depl, deg.
+    pub theta_star_depl_deg: f64,
+    /// max_θ Retr(e, θ) (= −min Depl).
+    pub max_retr: f64,
+    /// θ* of max Retr, rad (= −θ* of min Depl).
+    pub theta_star_retr_rad: f64,
+    /// θ* of max Retr, deg.
+    pub theta_star_retr_deg: f64,
+    /// Root-finder iterations.
+    pub iterations: u32,
+    /// Whether an equilibrium can exist at every θ for some rate (min Depl ≥ 0, i.e. e ≤ 0.75).
+    pub exists_whole_orbit: bool,
+}
 
 /// Pixel size of Fig. 3 (two panels side by side).
 pub const FIG3_SIZE_PX: (u32, u32) = (1400, 620);

@@ -14,7 +14,7 @@ use tss_reel::stability::{
     EquilibriumStability, FrozenCoefficients, ModeRoots, SwingState, Verdict,
 };
 
-use super::{eccentricity, finite, invalid, positive, AnalysisCliError, OutputFormat};
+use super::flags::{eccentricity, finite, invalid, positive, AnalysisCliError, OutputFormat};
 
 /// |α̈|, |β̈| below this × θ̇² count as zero: the state is an equilibrium.
 pub const EQUILIBRIUM_RESIDUAL_REL: f64 = 1e-9;

@@ -47,14 +47,14 @@ pub use params::{
     ReelModel, ReelParams, Sensing,
 };
 
-use crate::plant::{Command, ElasticObservation, Observation, Plant, SensorTruth};
+use crate::plant::{Command, DriveFigures, ElasticObservation, Observation, Plant, SensorTruth};
 use crate::reel::{Reel, ReelSaturation};
 use environment::Vec3;
 use feeding::{feed, Feed};
 use frame::{direction_angles, orbit_frame, orbit_state, plane_basis};
 use integration::{motor_torque, ReelDrive, State, Workspace};
 use params::check;
-use reel_drum::{DriveFigures, DrumParams, FlightDrum, Motion};
+use reel_drum::{DrumParams, FlightDrum, Motion};
 use tether::Layout;
 
 /// Everything observable about the truth model at one instant.

@@ -11,14 +11,14 @@
 //! therefore depends only on its scenario (never on threads or on other runs), and switching
 //! one fault on does not change the noise another sensor sees.
 
+mod plan;
 mod report;
 mod summary;
 
 pub use crate::random::Pcg32;
-use crate::sensors::{
-    EncoderModel, LoadCell, LoadCellModel, RateSensor, ReelEncoder, SwingSensor, SwingSensorModel,
-};
+use crate::sensors::{LoadCell, RateSensor, ReelEncoder, SwingSensor};
 pub use crate::sensors::{SensedQuantity, SensorErrors, Window};
+pub use plan::{Corruption, Glitch, InjectionPlan};
 pub use report::{
     fault_name, injected_faults, render_fault_summary, FaultSetup, ReelMechanism, EVENTS_SHOWN,
 };
@@ -26,67 +26,6 @@ pub use summary::{
     FaultEvent, FaultEventKind, FaultSummary, FaultTally, FlagTicks, SummaryBuilder, TautSummary,
     TickRecord, MAX_EVENTS, TUMBLE_ANGLE_RAD,
 };
-
-// ---- what is injected: the fault model's parameters -------------------------------------------
-
-/// A reading replaced by a fixed value (NaN, inf, anything) during a window.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Corruption {
-    /// Which quantity.
-    pub sensor: SensedQuantity,
-    /// When.
-    pub window: Window,
-    /// The reading, in the quantity's unit.
-    pub value: f64,
-}
-
-/// A one-tick error of the length encoder.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Glitch {
-    /// When, s (the tick at or after it).
-    pub at_s: f64,
-    /// Size of the error, m.
-    pub size_m: f64,
-}
-
-/// Everything injected between the plant and the controller: the parameters of an
-/// [`Injector`].
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct InjectionPlan {
-    /// Seed of the noise generators (one stream per sensor).
-    pub seed: u64,
-    /// The reel encoder (length and rate).
-    pub length: EncoderModel,
-    /// The swing sensor (α): errors, latency, α dropouts.
-    pub alpha: SwingSensorModel,
-    /// The α̇ sensor is fitted.
-    pub alpha_rate_enabled: bool,
-    /// The α̇ sensor's errors.
-    pub alpha_rate: SensorErrors,
-    /// The load cell.
-    pub load_cell: LoadCellModel,
-    /// Windows without a sample (the controller's `step_missing`).
-    pub dropout: Vec<Window>,
-    /// Corrupted readings.
-    pub corrupt: Vec<Corruption>,
-    /// Length-encoder glitches.
-    pub length_glitch: Vec<Glitch>,
-}
-
-impl InjectionPlan {
-    /// `true` if nothing is injected: the controller reads the truth (rounded to its type),
-    /// α̇ included.
-    pub fn is_transparent(&self) -> bool {
-        self.length.is_perfect()
-            && self.alpha.is_perfect()
-            && self.alpha_rate_enabled
-            && self.alpha_rate.is_perfect()
-            && self.load_cell.is_perfect()
-            && self.dropout.is_empty()
-            && self.corrupt.is_empty()
-            && self.length_glitch.is_empty()
-    }
-}
 
 // ---- sensors ----------------------------------------------------------------------------------
 
@@ -236,6 +175,7 @@ fn first_tick_at(t_s: f64, period_s: f64) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sensors::{EncoderModel, SwingSensorModel};
 
     fn truth(t_s: f64) -> Truth {
         Truth {

@@ -5,7 +5,8 @@ use std::fmt::Write as _;
 
 use tss_reel::controller::{Envelope, Fault, Health};
 
-use super::{FaultEventKind, FaultSummary, InjectionPlan};
+use super::plan::InjectionPlan;
+use super::summary::{FaultEventKind, FaultSummary};
 use crate::reel::ReelDrive;
 
 /// How many events [`render_fault_summary`] lists.

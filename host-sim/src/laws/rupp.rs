@@ -18,7 +18,7 @@
 
 use tss_reel::mass::MassModel;
 
-use super::Sensed;
+use super::sensed::Sensed;
 
 /// The gains of [`Rupp`] (dimensionless).
 #[derive(Clone, Copy, Debug, PartialEq)]

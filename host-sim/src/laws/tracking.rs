@@ -31,7 +31,7 @@
 
 use tss_reel::mass::MassModel;
 
-use super::Sensed;
+use super::sensed::Sensed;
 
 /// The schedule's and the loop's parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]

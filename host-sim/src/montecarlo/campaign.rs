@@ -11,11 +11,9 @@ use super::consistency::{ConsistencySums, RunConsistency, Watched};
 use crate::faults::Pcg32;
 use crate::history::History;
 use crate::report::summarize;
-use crate::scenario::Scenario;
+use crate::scenario::{nominal_in, Distribution, MonteCarloSection, Scenario};
 use crate::table1::probe_times_for;
 use crate::table1::Table1Comparison;
-
-use super::{nominal_in, Distribution, MonteCarloSection};
 
 /// Stream of [`run_seed`] that seeds a run's dispersion draws.
 pub const DISPERSION_STREAM: u64 = 0;

@@ -51,10 +51,3 @@ pub use cmd::{
 };
 pub use shard::{Shard, ShardSpec};
 pub use slurm::{campaign_slurm, SlurmArgs};
-// The `[montecarlo]` section's schema and rules are the scenario's (`crate::scenario`); they are
-// named here too, where a campaign's code looks for them.
-pub(crate) use crate::scenario::nominal_in;
-pub use crate::scenario::{
-    dispersible_fields, nominal_value, CriteriaSection, DispersionSection, Distribution,
-    MonteCarloSection,
-};

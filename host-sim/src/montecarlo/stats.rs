@@ -11,8 +11,7 @@ use super::campaign::{Criterion, Metric, RunRecord, WorstHealth};
 use super::consistency;
 use super::interval::{clopper_pearson, wilson, Interval, CONFIDENCE};
 use super::shard::Shard;
-use super::{Distribution, MonteCarloSection};
-use crate::scenario::Scenario;
+use crate::scenario::{DispersionSection, Distribution, MonteCarloSection, Scenario};
 
 /// How many failed runs the summary lists by index.
 pub const FAILED_RUNS_LISTED: usize = 20;
@@ -123,7 +122,7 @@ pub struct CampaignInfo<'a> {
     pub build: &'a str,
 }
 
-fn describe_dispersion(d: &super::DispersionSection, nominal: Option<f64>) -> String {
+fn describe_dispersion(d: &DispersionSection, nominal: Option<f64>) -> String {
     let nom = nominal.map_or_else(|| "?".to_string(), sig);
     match (d.distribution, d.relative) {
         (Distribution::Normal, false) => match d.mean {

@@ -11,8 +11,10 @@
 use tss_reel::controller::{ConfigError, Controller, Rule};
 use tss_reel::equilibrium::ECCENTRICITY_LIMIT;
 
+use super::dispersible::nominal_value;
+use super::error::Problem;
+use super::mission::Scenario;
 use super::rules::{num, Validator};
-use super::{nominal_value, Problem, Scenario};
 
 /// Records the first rule the flight controller's configuration breaks, if any.
 /// A key the scenario's own rules already reported is not reported again.

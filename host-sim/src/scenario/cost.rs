@@ -24,8 +24,12 @@
 //! When a bound is passed, the key blamed is the one whose default would bring the run
 //! closest to its bound (the dominant cause), named with its value and the figures.
 
+use super::dispersible::nominal_value;
+use super::mission::Scenario;
+use super::plant::PlantModel;
+use super::reel::{ReelModelName, ReelSection};
 use super::rules::{is_positive, num, Validator};
-use super::{PlantModel, ReelModelName, ReelSection, Scenario, TetherSection};
+use super::system::TetherSection;
 
 /// The most nodes (end bodies and beads) the elastic plant may hold: 10⁵, about 50 MB of state
 /// and integration workspace at [`BYTES_PER_NODE`].
@@ -296,7 +300,7 @@ pub(super) fn check(sc: &Scenario, v: &mut Validator) {
     let Some(cost) = elastic_cost(sc) else {
         return;
     };
-    let value = |key: &str| super::nominal_value(sc, key).map_or_else(|| "?".to_string(), num);
+    let value = |key: &str| nominal_value(sc, key).map_or_else(|| "?".to_string(), num);
     let nodes_ok = v.check(
         cost.nodes <= MAX_ELASTIC_NODES,
         "tether.segment_length_m",

@@ -14,9 +14,10 @@
 //! `faults.dropout[].from_s`; `--set` takes the whole array, e.g.
 //! `--set 'faults.dropout=[{ from_s = 600, until_s = 660 }]'`.
 
+use super::error::ScenarioError;
 use super::load::parse_override_value;
+use super::mission::Scenario;
 use super::schema::{schema, LeafKind};
-use super::{Scenario, ScenarioError};
 
 /// The base the defaults and rules are read from: the paper's scenario.
 pub const BASE_TOML: &str = include_str!("../../../scenarios/paper.toml");

@@ -6,8 +6,8 @@ use std::io::Read;
 use std::path::Path;
 
 use super::error::ScenarioError;
+use super::mission::Scenario;
 use super::schema::{schema, LeafKind, Schema};
-use super::Scenario;
 
 /// The largest scenario file read, bytes: the paper's scenarios are 2–6 KiB; a file of fault
 /// lists at their bounds stays well under this.

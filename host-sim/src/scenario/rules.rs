@@ -2,7 +2,7 @@
 //! [`Problem`] (field, value, message), so that a user sees all of them at once. The rules
 //! themselves live next to the section they check.
 
-use super::Problem;
+use super::error::Problem;
 
 /// Relative tolerance when checking that one interval is a whole multiple of another
 /// (e.g. the output interval of the control period): 1e-9 of the ratio.

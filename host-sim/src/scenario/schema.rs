@@ -8,7 +8,7 @@ use std::sync::OnceLock;
 
 use serde::Deserialize;
 
-use super::Scenario;
+use super::mission::Scenario;
 
 /// The type a scenario key holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
