@@ -25,9 +25,13 @@ use crate::faults::{
 use crate::reel::{Reel, ReelDrive};
 use crate::sensors::{EncoderModel, LoadCellModel, SwingSensorModel};
 
-use super::{
-    EncoderSection, EnvelopeSection, LoadCellSection, MonitorSection, RateSensorSection,
-    ReelModelName, ReelSection, Scenario, SensedDirection, SwingSensorSection, WindowSection,
+use super::envelope::EnvelopeSection;
+use super::mission::Scenario;
+use super::monitor::MonitorSection;
+use super::plant::SensedDirection;
+use super::reel::{ReelModelName, ReelSection};
+use super::sensors::{
+    EncoderSection, LoadCellSection, RateSensorSection, SwingSensorSection, WindowSection,
 };
 
 /// The smallest α noise the estimator is told, rad (its `Config::validate` floor): an ideal
@@ -155,29 +159,10 @@ impl MonitorSection {
     }
 }
 
-/// A sensor's bias, noise, quantum and stuck window (`stuck_from_s = inf`, the default, is
-/// never).
-fn errors(noise_std: f64, bias: f64, quantum: f64, stuck: (f64, f64)) -> SensorErrors {
-    SensorErrors {
-        noise_std,
-        bias,
-        quantum,
-        stuck: (stuck.0 != f64::INFINITY).then_some(Window {
-            from_s: stuck.0,
-            until_s: stuck.1,
-        }),
-    }
-}
-
 impl From<&EncoderSection> for EncoderModel {
     fn from(s: &EncoderSection) -> Self {
         Self {
-            errors: errors(
-                s.noise_std,
-                s.bias,
-                s.quantum,
-                (s.stuck_from_s, s.stuck_until_s),
-            ),
+            errors: s.errors(),
             counts_per_rev: s.counts_per_rev,
             drum_radius_m: s.drum_radius_m,
         }
@@ -186,12 +171,7 @@ impl From<&EncoderSection> for EncoderModel {
 
 impl From<&RateSensorSection> for SensorErrors {
     fn from(s: &RateSensorSection) -> Self {
-        errors(
-            s.noise_std,
-            s.bias,
-            s.quantum,
-            (s.stuck_from_s, s.stuck_until_s),
-        )
+        s.errors()
     }
 }
 
@@ -199,7 +179,12 @@ impl From<&LoadCellSection> for LoadCellModel {
     fn from(s: &LoadCellSection) -> Self {
         Self {
             enabled: s.enabled,
-            errors: errors(s.noise_std_n, s.bias_n, s.quantum_n, (f64::INFINITY, 0.0)),
+            errors: SensorErrors {
+                noise_std: s.noise_std_n,
+                bias: s.bias_n,
+                quantum: s.quantum_n,
+                stuck: None,
+            },
             full_scale_n: s.full_scale_n,
         }
     }
@@ -208,12 +193,7 @@ impl From<&LoadCellSection> for LoadCellModel {
 /// The swing sensor of `[sensors.alpha]` with the α dropouts of `[[faults.alpha_dropout]]`.
 fn swing_sensor(s: &SwingSensorSection, dropout: &[WindowSection]) -> SwingSensorModel {
     SwingSensorModel {
-        errors: errors(
-            s.noise_std,
-            s.bias,
-            s.quantum,
-            (s.stuck_from_s, s.stuck_until_s),
-        ),
+        errors: s.errors(),
         latency_periods: s.latency_periods,
         dropout_prob: s.dropout_prob,
         dropout: dropout.iter().map(Window::from).collect(),

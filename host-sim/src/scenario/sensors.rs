@@ -10,7 +10,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::sensors::SensedQuantity;
+use crate::sensors::{SensedQuantity, SensorErrors, Window};
 
 use super::rules::{num, Validator};
 
@@ -37,140 +37,127 @@ pub struct SensorsSection {
     pub load_cell: LoadCellSection,
 }
 
-/// `[sensors.length]`: the reel encoder. The length the drum has paid out, plus bias and
-/// noise, rounded to `quantum` and frozen in a stuck window (as any sensor below), is counted
-/// in whole encoder counts of 2π·`drum_radius_m`/`counts_per_rev` (when `counts_per_rev` > 0);
-/// the reel's rate is the count difference over the period. With `counts_per_rev = 0` and no
-/// error the encoder reads the truth, length and rate.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct EncoderSection {
-    /// Standard deviation of white Gaussian noise added to the length every sample, m
-    /// (tether slip and stretch on the drum; 0 = none).
-    #[serde(default)]
-    pub noise_std: f64,
-    /// Constant offset of the length, m (the zero of the count).
-    #[serde(default)]
-    pub bias: f64,
-    /// Quantisation step of the length, m (0 = none; `counts_per_rev` is the encoder's own).
-    #[serde(default)]
-    pub quantum: f64,
-    /// The encoder repeats the count it gave at this time, s (inf = never).
-    #[serde(default = "infinity")]
-    pub stuck_from_s: f64,
-    /// … until this time, s (inf = to the end of the run).
-    #[serde(default = "infinity")]
-    pub stuck_until_s: f64,
-    /// Encoder counts per drum revolution (0: no counting, the length is continuous).
-    #[serde(default)]
-    pub counts_per_rev: u32,
-    /// Radius of the drum the tether leaves, m: one count is 2π·radius/counts_per_rev of tether.
-    #[serde(default = "drum_radius_m")]
-    pub drum_radius_m: f64,
+/// Declares the section of a sensor that reads through the errors every such sensor shares:
+/// `noise_std`, `bias`, `quantum` and a stuck window (`stuck_from_s`, `stuck_until_s`), in the
+/// sensor's unit, after the sensor's own fields. Each section stays its own serde struct with
+/// `deny_unknown_fields` (a shared struct `#[serde(flatten)]`ed into each would lose it), and
+/// a field a file leaves out takes the section's `Default`.
+macro_rules! sensor_section {
+    (
+        $(#[$doc:meta])*
+        pub struct $name:ident in $unit:literal {
+            $(
+                $(#[$field_doc:meta])*
+                pub $field:ident: $ty:ty = $default:expr,
+            )*
+        }
+    ) => {
+        $(#[$doc])*
+        #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+        #[serde(default, deny_unknown_fields)]
+        pub struct $name {
+            $(
+                $(#[$field_doc])*
+                pub $field: $ty,
+            )*
+            #[doc = concat!("Standard deviation of white Gaussian noise added every sample, ", $unit, " (0 = none).")]
+            pub noise_std: f64,
+            #[doc = concat!("Constant offset added to every sample, ", $unit, ".")]
+            pub bias: f64,
+            #[doc = concat!("Quantisation step, ", $unit, " (0 = none).")]
+            pub quantum: f64,
+            /// The sensor repeats the reading it gave at this time, s (inf = never).
+            pub stuck_from_s: f64,
+            /// … until this time, s (inf = to the end of the run).
+            pub stuck_until_s: f64,
+        }
+
+        impl Default for $name {
+            fn default() -> Self {
+                Self {
+                    $($field: $default,)*
+                    noise_std: 0.0,
+                    bias: 0.0,
+                    quantum: 0.0,
+                    stuck_from_s: f64::INFINITY,
+                    stuck_until_s: f64::INFINITY,
+                }
+            }
+        }
+
+        impl $name {
+            /// The shared errors as the simulator's sensor models take them (a stuck window
+            /// from `inf`, the default, is none).
+            pub fn errors(&self) -> SensorErrors {
+                SensorErrors {
+                    noise_std: self.noise_std,
+                    bias: self.bias,
+                    quantum: self.quantum,
+                    stuck: (self.stuck_from_s != f64::INFINITY).then_some(Window {
+                        from_s: self.stuck_from_s,
+                        until_s: self.stuck_until_s,
+                    }),
+                }
+            }
+
+            /// Finite errors, a non-negative deviation and quantum, a stuck window that does
+            /// not end before it starts; `at` is the section's key (`sensors.alpha`).
+            fn check_errors(&self, at: &str, v: &mut Validator) {
+                v.non_negative(&format!("{at}.noise_std"), self.noise_std);
+                v.finite(&format!("{at}.bias"), self.bias);
+                v.non_negative(&format!("{at}.quantum"), self.quantum);
+                v.window(
+                    &format!("{at}.stuck_from_s"),
+                    self.stuck_from_s,
+                    &format!("{at}.stuck_until_s"),
+                    self.stuck_until_s,
+                    true,
+                );
+            }
+        }
+    };
 }
 
-impl Default for EncoderSection {
-    fn default() -> Self {
-        Self {
-            noise_std: 0.0,
-            bias: 0.0,
-            quantum: 0.0,
-            stuck_from_s: f64::INFINITY,
-            stuck_until_s: f64::INFINITY,
-            counts_per_rev: 0,
-            drum_radius_m: drum_radius_m(),
-        }
+sensor_section! {
+    /// `[sensors.length]`: the reel encoder. The length the drum has paid out, plus bias and
+    /// noise (tether slip and stretch on the drum; the bias is the zero of the count), rounded
+    /// to `quantum` and frozen in a stuck window (as any sensor below), is counted in whole
+    /// encoder counts of 2π·`drum_radius_m`/`counts_per_rev` (when `counts_per_rev` > 0); the
+    /// reel's rate is the count difference over the period. With `counts_per_rev = 0` and no
+    /// error the encoder reads the truth, length and rate.
+    pub struct EncoderSection in "m" {
+        /// Encoder counts per drum revolution (0: no counting, the length is continuous).
+        pub counts_per_rev: u32 = 0,
+        /// Radius of the drum the tether leaves, m: one count is 2π·radius/counts_per_rev of
+        /// tether (default 0.1 m: a 20 cm drum, the size of a small deployer's spool).
+        pub drum_radius_m: f64 = 0.1,
     }
 }
 
-/// The default drum radius, m (a 20 cm drum, the size of a small deployer's spool).
-fn drum_radius_m() -> f64 {
-    0.1
-}
-
-/// `[sensors.alpha]`: the swing sensor (a deployer angle sensor or relative navigation). Each
-/// period it measures α + bias + noise, rounded to `quantum` (frozen in a stuck window); the
-/// controller receives the measurement of `latency_periods` periods ago, or nothing (an α
-/// dropout, `alpha_rad: None`: the estimator predicts only) with probability `dropout_prob`,
-/// in a `[[faults.alpha_dropout]]` window, and in the first `latency_periods` periods.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SwingSensorSection {
-    /// Standard deviation of white Gaussian noise added every sample, rad (0 = none).
-    #[serde(default)]
-    pub noise_std: f64,
-    /// Constant offset added to every sample, rad (misalignment).
-    #[serde(default)]
-    pub bias: f64,
-    /// Quantisation step, rad (0 = none).
-    #[serde(default)]
-    pub quantum: f64,
-    /// The sensor repeats the reading it gave at this time, s (inf = never).
-    #[serde(default = "infinity")]
-    pub stuck_from_s: f64,
-    /// … until this time, s (inf = to the end of the run).
-    #[serde(default = "infinity")]
-    pub stuck_until_s: f64,
-    /// Whole control periods between measuring α and the controller receiving it (0: the
-    /// reading is of this period).
-    #[serde(default)]
-    pub latency_periods: u16,
-    /// Probability that a period's α does not arrive (independent draws; 0 = never).
-    #[serde(default)]
-    pub dropout_prob: f64,
-}
-
-impl Default for SwingSensorSection {
-    fn default() -> Self {
-        Self {
-            noise_std: 0.0,
-            bias: 0.0,
-            quantum: 0.0,
-            stuck_from_s: f64::INFINITY,
-            stuck_until_s: f64::INFINITY,
-            latency_periods: 0,
-            dropout_prob: 0.0,
-        }
+sensor_section! {
+    /// `[sensors.alpha]`: the swing sensor (a deployer angle sensor or relative navigation).
+    /// Each period it measures α + bias (misalignment) + noise, rounded to `quantum` (frozen in
+    /// a stuck window); the controller receives the measurement of `latency_periods` periods
+    /// ago, or nothing (an α dropout, `alpha_rad: None`: the estimator predicts only) with
+    /// probability `dropout_prob`, in a `[[faults.alpha_dropout]]` window, and in the first
+    /// `latency_periods` periods.
+    pub struct SwingSensorSection in "rad" {
+        /// Whole control periods between measuring α and the controller receiving it (0: the
+        /// reading is of this period).
+        pub latency_periods: u16 = 0,
+        /// Probability that a period's α does not arrive (independent draws; 0 = never).
+        pub dropout_prob: f64 = 0.0,
     }
 }
 
-/// `[sensors.alpha_rate]`: an α̇ rate sensor, which no flight has carried: the paper's
-/// idealisation (Table 1), for comparison. Off unless `enabled`; then α̇ + bias + noise,
-/// rounded to `quantum`, frozen in a stuck window.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RateSensorSection {
-    /// The sensor is fitted and read (the controller then flies on it, the paper's law as
-    /// printed; without it the controller flies its estimator on α alone).
-    #[serde(default)]
-    pub enabled: bool,
-    /// Standard deviation of white Gaussian noise added every sample, rad/s (0 = none).
-    #[serde(default)]
-    pub noise_std: f64,
-    /// Constant offset added to every sample, rad/s.
-    #[serde(default)]
-    pub bias: f64,
-    /// Quantisation step, rad/s (0 = none).
-    #[serde(default)]
-    pub quantum: f64,
-    /// The sensor repeats the reading it gave at this time, s (inf = never).
-    #[serde(default = "infinity")]
-    pub stuck_from_s: f64,
-    /// … until this time, s (inf = to the end of the run).
-    #[serde(default = "infinity")]
-    pub stuck_until_s: f64,
-}
-
-impl Default for RateSensorSection {
-    fn default() -> Self {
-        Self {
-            enabled: false,
-            noise_std: 0.0,
-            bias: 0.0,
-            quantum: 0.0,
-            stuck_from_s: f64::INFINITY,
-            stuck_until_s: f64::INFINITY,
-        }
+sensor_section! {
+    /// `[sensors.alpha_rate]`: an α̇ rate sensor, which no flight has carried: the paper's
+    /// idealisation (Table 1), for comparison. Off unless `enabled`; then α̇ + bias + noise,
+    /// rounded to `quantum`, frozen in a stuck window.
+    pub struct RateSensorSection in "rad/s" {
+        /// The sensor is fitted and read (the controller then flies on it, the paper's law as
+        /// printed; without it the controller flies its estimator on α alone).
+        pub enabled: bool = false,
     }
 }
 
@@ -274,41 +261,10 @@ impl SensorsSection {
     /// before they start; a drum radius above 0 when the encoder counts; a probability in
     /// [0, 1]; a full scale above 0.
     pub(super) fn check(&self, v: &mut Validator) {
-        let (l, a, r) = (&self.length, &self.alpha, &self.alpha_rate);
-        for (name, noise_std, bias, quantum, (from, until)) in [
-            (
-                "sensors.length",
-                l.noise_std,
-                l.bias,
-                l.quantum,
-                (l.stuck_from_s, l.stuck_until_s),
-            ),
-            (
-                "sensors.alpha",
-                a.noise_std,
-                a.bias,
-                a.quantum,
-                (a.stuck_from_s, a.stuck_until_s),
-            ),
-            (
-                "sensors.alpha_rate",
-                r.noise_std,
-                r.bias,
-                r.quantum,
-                (r.stuck_from_s, r.stuck_until_s),
-            ),
-        ] {
-            v.non_negative(&format!("{name}.noise_std"), noise_std);
-            v.finite(&format!("{name}.bias"), bias);
-            v.non_negative(&format!("{name}.quantum"), quantum);
-            v.window(
-                &format!("{name}.stuck_from_s"),
-                from,
-                &format!("{name}.stuck_until_s"),
-                until,
-                true,
-            );
-        }
+        let (l, a) = (&self.length, &self.alpha);
+        l.check_errors("sensors.length", v);
+        a.check_errors("sensors.alpha", v);
+        self.alpha_rate.check_errors("sensors.alpha_rate", v);
         if l.counts_per_rev > 0 {
             v.positive("sensors.length.drum_radius_m", l.drum_radius_m);
         } else {
