@@ -40,7 +40,7 @@ use crate::history::{History, Sample};
 use crate::montecarlo::campaign::Metric;
 use crate::montecarlo::{Campaign, Outcome};
 use crate::output::OutputSet;
-use crate::plots::{check_font, draw_error, write_png_and_svg, Figure, FONT};
+use crate::plots::{check_font, draw_error, tick_label, write_png_and_svg, Figure, FONT};
 use crate::report::summarize;
 use crate::scenario::{LawName, PlantModel, Scenario};
 use crate::table1::probe_times_for;
@@ -66,7 +66,8 @@ pub struct CompareArgs {
     /// The campaign's seed (with --runs).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Output directory [default: out/NAME-compare].
+    /// Output directory [default: out/NAME/compare, with the overrides in NAME as `run` writes
+    /// them: out/NAME+KEY=VALUE/compare].
     #[arg(long, short, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Override one scenario field, dotted key and TOML value (repeatable).
@@ -452,7 +453,7 @@ pub fn compare(args: &CompareArgs) -> anyhow::Result<()> {
     let dir = args
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-compare", sc.name)));
+        .unwrap_or_else(|| crate::output::default_dir(&sc.name, &args.set).join("compare"));
     let mut out = OutputSet::prepare("--out", &dir, output_names())?;
 
     let mut rows = Vec::new();
@@ -633,6 +634,8 @@ fn draw_panel<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc("t (h)")
         .y_desc(y_desc)
+        .x_label_formatter(&|x| tick_label(*x, x1 - x0))
+        .y_label_formatter(&|y| tick_label(*y, y1 - y0))
         .label_style((FONT, 15))
         .axis_desc_style((FONT, 16))
         .light_line_style(RGBColor(0xee, 0xee, 0xee))

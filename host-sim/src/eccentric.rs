@@ -18,7 +18,7 @@ use plotters::prelude::*;
 
 use crate::history::{History, PhaseLabel};
 use crate::output::OutputSet;
-use crate::plots::{draw_error, png_and_svg, write_png_and_svg, FONT};
+use crate::plots::{draw_error, png_and_svg, tick_label, write_png_and_svg, FONT};
 use crate::scenario::Scenario;
 use crate::sim;
 use crate::table1::{probe_times_for, Table1Comparison};
@@ -319,6 +319,7 @@ fn draw<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc("eccentricity e")
         .y_desc("keep error max |l − l_keep| (m)")
+        .x_label_formatter(&|e| tick_label(*e, e_max))
         .label_style((FONT, 16))
         .draw()?;
     let blue = RGBColor(0x1f, 0x77, 0xb4);

@@ -14,6 +14,14 @@ fn tss_sim(args: &[&str]) -> Output {
     Command::new(BIN).args(args).output().expect("tss-sim runs")
 }
 
+/// `tss-sim run scenarios/paper.toml -o OUT ARGS...`.
+fn run_paper(out: &Path, args: &[&str]) -> Output {
+    let (paper, out) = (paper(), out.to_str().unwrap().to_string());
+    let mut all = vec!["run", paper.to_str().unwrap(), "-o", &out];
+    all.extend(args);
+    tss_sim(&all)
+}
+
 fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }
@@ -36,15 +44,7 @@ fn completions_are_generated_for_each_shell() {
 fn quiet_prints_nothing_and_writes_everything() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("q");
-    let o = tss_sim(&[
-        "run",
-        paper().to_str().unwrap(),
-        "--quiet",
-        "-o",
-        out.to_str().unwrap(),
-        "--set",
-        "simulation.duration_s=60",
-    ]);
+    let o = run_paper(&out, &["--quiet", "--set", "simulation.duration_s=60"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(o.stdout.is_empty(), "{}", text(&o.stdout));
     assert!(o.stderr.is_empty(), "{}", text(&o.stderr));
@@ -90,17 +90,16 @@ fn every_command_that_writes_files_takes_dash_o() {
 fn a_pil_run_longer_than_the_firmware_allows_is_refused_before_it_starts() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("pil");
-    let o = tss_sim(&[
-        "run",
-        paper().to_str().unwrap(),
-        "--pil",
-        "--firmware",
-        BIN,
-        "-o",
-        out.to_str().unwrap(),
-        "--set",
-        "simulation.duration_s=200000",
-    ]);
+    let o = run_paper(
+        &out,
+        &[
+            "--pil",
+            "--firmware",
+            BIN,
+            "--set",
+            "simulation.duration_s=200000",
+        ],
+    );
     assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
     let err = text(&o.stderr);
     assert!(
@@ -117,14 +116,7 @@ fn a_pil_run_longer_than_the_firmware_allows_is_refused_before_it_starts() {
 fn values_the_simulation_refuses_before_its_first_step_are_usage_errors() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("timing");
-    let o = tss_sim(&[
-        "run",
-        paper().to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--set",
-        "simulation.output_interval_s=1e300",
-    ]);
+    let o = run_paper(&out, &["--set", "simulation.output_interval_s=1e300"]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
     assert!(text(&o.stderr).contains("simulation.output_interval_s"));
     assert!(!out.exists());
@@ -136,14 +128,7 @@ fn values_the_simulation_refuses_before_its_first_step_are_usage_errors() {
 fn a_run_logs_its_progress_every_simulated_hour_when_not_on_a_terminal() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("p");
-    let o = tss_sim(&[
-        "run",
-        paper().to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--set",
-        "simulation.duration_s=10800",
-    ]);
+    let o = run_paper(&out, &["--set", "simulation.duration_s=10800"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let err = text(&o.stderr);
     for h in 1..=3 {
@@ -151,8 +136,13 @@ fn a_run_logs_its_progress_every_simulated_hour_when_not_on_a_terminal() {
     }
 }
 
-fn tss_sim_in(cwd: &Path, args: &[&str]) -> Output {
+/// `tss-sim -q COMMAND scenarios/paper.toml --set simulation.duration_s=60 ARGS...` in `cwd`,
+/// without `--out`.
+fn paper_in(cwd: &Path, command: &str, args: &[&str]) -> Output {
+    let paper = paper();
     Command::new(BIN)
+        .args(["-q", command, paper.to_str().unwrap()])
+        .args(["--set", "simulation.duration_s=60"])
         .args(args)
         .current_dir(cwd)
         .output()
@@ -166,17 +156,7 @@ fn tss_sim_in(cwd: &Path, args: &[&str]) -> Output {
 #[test]
 fn a_run_without_out_never_replaces_another_runs_results() {
     let tmp = tempfile::tempdir().unwrap();
-    let paper = paper();
-    let plain = tss_sim_in(
-        tmp.path(),
-        &[
-            "-q",
-            "run",
-            paper.to_str().unwrap(),
-            "--set",
-            "simulation.duration_s=60",
-        ],
-    );
+    let plain = paper_in(tmp.path(), "run", &[]);
     assert!(plain.status.success(), "{}", text(&plain.stderr));
     let dirs = |p: &Path| -> Vec<String> {
         let mut v: Vec<String> = std::fs::read_dir(p)
@@ -188,18 +168,7 @@ fn a_run_without_out_never_replaces_another_runs_results() {
     };
     let first = dirs(&tmp.path().join("out"));
     assert_eq!(first.len(), 1, "{first:?}");
-    let varied = tss_sim_in(
-        tmp.path(),
-        &[
-            "-q",
-            "run",
-            paper.to_str().unwrap(),
-            "--set",
-            "simulation.duration_s=60",
-            "--set",
-            "orbit.eccentricity=0.05",
-        ],
-    );
+    let varied = paper_in(tmp.path(), "run", &["--set", "orbit.eccentricity=0.05"]);
     assert!(varied.status.success(), "{}", text(&varied.stderr));
     let second = dirs(&tmp.path().join("out"));
     assert_eq!(second.len(), 2, "{second:?}");
@@ -208,6 +177,34 @@ fn a_run_without_out_never_replaces_another_runs_results() {
         second.iter().any(|d| d.contains("orbit.eccentricity=0.05")),
         "{second:?}"
     );
+    // `compare` writes into the scenario's directory, in one of its own named after it, and
+    // with overrides into theirs: it replaces neither run's results nor another compare's.
+    let plain_files = dirs(&tmp.path().join("out").join(&first[0]));
+    let compared = paper_in(tmp.path(), "compare", &["--laws", "paper,rupp"]);
+    assert!(compared.status.success(), "{}", text(&compared.stderr));
+    let varied_compare = paper_in(
+        tmp.path(),
+        "compare",
+        &["--laws", "paper,rupp", "--set", "orbit.eccentricity=0.05"],
+    );
+    assert!(
+        varied_compare.status.success(),
+        "{}",
+        text(&varied_compare.stderr)
+    );
+    assert_eq!(dirs(&tmp.path().join("out")), second);
+    for dir in &second {
+        let compare = tmp.path().join("out").join(dir).join("compare");
+        assert!(
+            compare.join("compare.txt").is_file(),
+            "{}",
+            compare.display()
+        );
+    }
+    let mut with_compare = plain_files.clone();
+    with_compare.push("compare".to_string());
+    with_compare.sort();
+    assert_eq!(dirs(&tmp.path().join("out").join(&first[0])), with_compare);
 }
 
 /// Issue 30 §5: a rigid run listed its figures under a heading about the tether's shape on the
@@ -216,14 +213,7 @@ fn a_run_without_out_never_replaces_another_runs_results() {
 fn a_rigid_run_s_figures_are_not_said_to_show_the_tether_s_shape() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("r");
-    let o = tss_sim(&[
-        "run",
-        paper().to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--set",
-        "simulation.duration_s=60",
-    ]);
+    let o = run_paper(&out, &["--set", "simulation.duration_s=60"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let stdout = text(&o.stdout);
     assert!(

@@ -11,7 +11,7 @@ use plotters::prelude::*;
 use serde::Serialize;
 
 use crate::output::OutputSet;
-use crate::plots::{draw_error, png_and_svg, write_png_and_svg, FONT};
+use crate::plots::{draw_error, png_and_svg, tick_label, write_png_and_svg, FONT};
 
 /// One row of Fig. 3: the whole-orbit bounds of Eq. 13 at one e.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -155,6 +155,8 @@ fn draw_fig3<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc("orbit eccentricity e (-)")
         .y_desc("(2+mu3) ldot/(omega l) bound (-)")
+        .x_label_formatter(&|x| tick_label(*x, e1 - e0))
+        .y_label_formatter(&|y| tick_label(*y, y1 - y0))
         .label_style((FONT, 16))
         .axis_desc_style((FONT, 18))
         .light_line_style(RGBColor(0xee, 0xee, 0xee))
@@ -201,6 +203,8 @@ fn draw_fig3<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc("orbit eccentricity e (-)")
         .y_desc("theta* (deg)")
+        .x_label_formatter(&|x| tick_label(*x, e1 - e0))
+        .y_label_formatter(&|t| tick_label(*t, t1 - t0))
         .label_style((FONT, 16))
         .axis_desc_style((FONT, 18))
         .light_line_style(RGBColor(0xee, 0xee, 0xee))
@@ -281,6 +285,7 @@ fn draw_fig2<DB: DrawingBackend>(
             .x_desc("true anomaly theta (deg)")
             .y_desc(y_desc)
             .x_labels(9)
+            .y_label_formatter(&|y| tick_label(*y, y1 - y0))
             .label_style((FONT, 16))
             .axis_desc_style((FONT, 18))
             .light_line_style(RGBColor(0xee, 0xee, 0xee))

@@ -36,7 +36,7 @@ use tss_reel::Real;
 
 use super::exact_sum::ExactSum;
 use crate::history::History;
-use crate::plots::{draw_error as err, Figure, FONT};
+use crate::plots::{draw_error as err, tick_label, Figure, FONT};
 use crate::scenario::Scenario;
 use crate::sim::{SimError, Stepper};
 
@@ -596,6 +596,8 @@ fn panel<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc("mission time (h)")
         .y_desc("average over runs")
+        .x_label_formatter(&|x| tick_label(*x, t1))
+        .y_label_formatter(&|y| tick_label(*y, 1.5 * top))
         .label_style((FONT, 13))
         .axis_desc_style((FONT, 14))
         .light_line_style(RGBColor(0xee, 0xee, 0xee))

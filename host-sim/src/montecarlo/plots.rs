@@ -8,9 +8,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::campaign::{Metric, RunRecord};
-use super::stats::sig;
 use crate::output::OutputSet;
-use crate::plots::{draw_error as err, png_and_svg, write_png_and_svg, Figure, FONT};
+use crate::plots::{draw_error as err, png_and_svg, tick_label, write_png_and_svg, Figure, FONT};
 use crate::scenario::Scenario;
 /// Bins per histogram.
 pub const HISTOGRAM_BINS: usize = 30;
@@ -202,7 +201,7 @@ fn histogram<DB: DrawingBackend>(
         .configure_mesh()
         .y_desc("runs")
         .x_labels(6)
-        .x_label_formatter(&|x| sig(*x))
+        .x_label_formatter(&|x| tick_label(*x, x1 - x0))
         // Whole runs: no more labels than whole numbers up to the top, so none repeats.
         .y_labels((top.floor() as usize + 1).min(10))
         .y_label_formatter(&|y| format!("{y:.0}"))
@@ -302,8 +301,8 @@ fn scatter_panel<DB: DrawingBackend>(
         .y_desc(m.name())
         .x_labels(5)
         .y_labels(6)
-        .x_label_formatter(&|x| sig(*x))
-        .y_label_formatter(&|y| sig(*y))
+        .x_label_formatter(&|x| tick_label(*x, x1 - x0))
+        .y_label_formatter(&|y| tick_label(*y, y1 - y0))
         .label_style((FONT, 13))
         .axis_desc_style((FONT, 14))
         .light_line_style(RGBColor(0xee, 0xee, 0xee))
