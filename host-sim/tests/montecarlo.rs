@@ -71,23 +71,8 @@ fn stderr(o: &Output) -> String {
 /// `tss-sim montecarlo` on the paper campaign into `out`, without figures; panics unless it
 /// succeeds.
 fn campaign(out: &Path, runs: u32, seed: u32, extra: &[&str]) -> Output {
-    let runs = runs.to_string();
-    let seed = seed.to_string();
-    let sc = scenario();
-    let mut args = vec![
-        "montecarlo",
-        sc.to_str().unwrap(),
-        "--runs",
-        &runs,
-        "--seed",
-        &seed,
-        "--out",
-        out.to_str().unwrap(),
-        "--no-figures",
-    ];
-    args.extend_from_slice(extra);
-    let o = tss_sim(&args);
-    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    let o = montecarlo_env(out, &runs.to_string(), &seed.to_string(), extra, &[]);
+    assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
     o
 }
 
@@ -559,7 +544,8 @@ fn with<'a>(a: &[&'a str], b: &[&'a str]) -> Vec<&'a str> {
     [a, b].concat()
 }
 
-/// `montecarlo` on the paper campaign with `extra`, and the environment `env`.
+/// `montecarlo` on the paper campaign into `out`, without figures, with `extra`, and the
+/// environment `env`.
 fn montecarlo_env(
     out: &Path,
     runs: &str,
