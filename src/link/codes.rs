@@ -4,7 +4,8 @@
 use crate::controller::{Fault, Flags, Health, Output, Phase, Sensor};
 use crate::law::LawFault;
 
-use super::{Command, LinkError, SampleStatus};
+use super::error::LinkError;
+use super::messages::{Command, SampleStatus};
 
 /// The wire code of a phase.
 pub fn phase_code(p: Phase) -> u8 {

@@ -1,6 +1,6 @@
 //! The receiving side's sequence and tick checks on sample frames.
 
-use super::{LinkCounters, Sample};
+use super::messages::{LinkCounters, Sample};
 
 /// What a [`SampleGate`] made of one valid sample frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
