@@ -306,44 +306,30 @@ impl FaultsSection {
         let corrupt_ok = within("corrupt", self.corrupt.len());
         let glitch_ok = within("length_glitch", self.length_glitch.len());
         let take = |ok: bool| if ok { usize::MAX } else { 0 };
-        for (i, w) in self.dropout.iter().take(take(dropout_ok)).enumerate() {
-            let at = format!("faults.dropout[{i}]");
-            v.window(
-                &format!("{at}.from_s"),
-                w.from_s,
-                &format!("{at}.until_s"),
-                w.until_s,
-                false,
-            );
-        }
-        for (i, w) in self
-            .alpha_dropout
-            .iter()
-            .take(take(alpha_dropout_ok))
-            .enumerate()
-        {
-            let at = format!("faults.alpha_dropout[{i}]");
-            v.window(
-                &format!("{at}.from_s"),
-                w.from_s,
-                &format!("{at}.until_s"),
-                w.until_s,
-                false,
-            );
-        }
-        for (i, c) in self.corrupt.iter().take(take(corrupt_ok)).enumerate() {
-            let at = format!("faults.corrupt[{i}]");
-            v.window(
-                &format!("{at}.from_s"),
-                c.from_s,
-                &format!("{at}.until_s"),
-                c.until_s,
-                false,
-            );
-        }
+        let span = |w: &WindowSection| (w.from_s, w.until_s);
+        let dropouts = self.dropout.iter().take(take(dropout_ok));
+        check_windows("dropout", dropouts.map(span), v);
+        let alpha_dropouts = self.alpha_dropout.iter().take(take(alpha_dropout_ok));
+        check_windows("alpha_dropout", alpha_dropouts.map(span), v);
+        let corrupt = self.corrupt.iter().take(take(corrupt_ok));
+        check_windows("corrupt", corrupt.map(|c| (c.from_s, c.until_s)), v);
         for (i, g) in self.length_glitch.iter().take(take(glitch_ok)).enumerate() {
             v.non_negative(&format!("faults.length_glitch[{i}].at_s"), g.at_s);
             v.finite(&format!("faults.length_glitch[{i}].size_m"), g.size_m);
         }
+    }
+}
+
+/// Each window of the list `faults.{list}` starts at a finite time ≥ 0 and ends after it starts.
+fn check_windows(list: &str, windows: impl Iterator<Item = (f64, f64)>, v: &mut Validator) {
+    for (i, (from_s, until_s)) in windows.enumerate() {
+        let at = format!("faults.{list}[{i}]");
+        v.window(
+            &format!("{at}.from_s"),
+            from_s,
+            &format!("{at}.until_s"),
+            until_s,
+            false,
+        );
     }
 }
