@@ -21,7 +21,7 @@
 //!                                  keeps it)
 //! 5       1     kind     u8        0 Hello, 1 Sample, 2 Command, 3 End, 4 Report, 5 Params,
 //!                                  6 Loaded
-//! 6       n     body               the kind's fields, in declaration order (below)
+//! 6       n     body               the kind's fields, in declaration order (`messages.rs`)
 //! 6+n     4     crc      u32       CRC-32/ISO-HDLC over bytes 0 .. 6+n
 //! ```
 //!
