@@ -10,6 +10,14 @@
 //!    every 5 s by `tests/bench_data.rs`, interpolated to 1 s): deploy, keep, slew, retrieve,
 //!    keep, 72 001 steps.
 //!
+//! Both fly `Config::flight()` as the firmware does (the law on the onboard estimator, the
+//! tension loop between the law and the limits), with a working load cell: each sample carries
+//! the tension at the reel in the recorded state (`tss_reel::recordings::load_cell`: Eq. 5a
+//! from the recorded l, α, α̇ and the length's differences), so the tension loop tracks it
+//! (washout, tension window, admittance term) at every step that has one. The recordings
+//! themselves carry no tension (the firmware's replay flies without a load cell, its loop
+//! waiting for one), and a step without a reading is the cheaper path.
+//!
 //! Run it with `scripts/bench-target`.
 //!
 //! ## How instructions are counted
@@ -58,6 +66,7 @@ mod bench {
     use tss_reel::equilibrium::ExistenceMonitor;
     pub use tss_reel::firmware::bench::{Meter, Stats, K};
     use tss_reel::law::{self, Blend, LawInput};
+    use tss_reel::recordings::load_cell;
     use tss_reel::schedule::{PreparedBand, Reference};
 
     /// Whether this build also times the parts of each nominal step (`TSS_BENCH_PARTS` set at
@@ -237,15 +246,16 @@ mod bench {
     }
 
     /// Flies a fresh controller in the flight configuration (`Config::flight`: the paper's
-    /// mission on the estimator) over `ticks` samples (`None`: a dropout) and measures every
-    /// step, and the parts of every nominal one. A sample gives the controller l, α, and the
-    /// encoder's rate (the recorded length's change since the previous sample), not α̇.
+    /// mission on the estimator, with the tension loop) over `ticks` samples (`None`: a
+    /// dropout) and measures every step, and the parts of every nominal one. A sample gives the
+    /// controller l, α, the encoder's rate (the recorded length's change since the previous
+    /// sample) and the load cell's tension (Eq. 5a in the recorded state), not α̇.
     fn run(
         m: &Meter,
         r: &mut Run,
         ticks: u32,
         orbit_rate_radps: f32,
-        mut sample: impl FnMut(u32) -> Option<[f32; 3]>,
+        sample: impl Fn(u32) -> Option<[f32; 3]>,
     ) {
         let Ok(mut ctl) = Controller::new(Config::<f32>::flight()) else {
             defmt::error!("the flight configuration was rejected");
@@ -264,7 +274,13 @@ mod bench {
                 tick,
                 length_m: s[0],
                 reel_rate_mps: previous_length.map(|l| (s[0] - l) / cfg.period_s),
-                tension_n: None,
+                tension_n: load_cell::tension_n(
+                    &sample,
+                    tick,
+                    cfg.period_s,
+                    &cfg.masses,
+                    orbit_rate_radps,
+                ),
                 alpha_rad: Some(s[1]),
                 alpha_rate_radps: None,
                 orbit_rate_radps,
@@ -318,7 +334,7 @@ mod bench {
         name: &str,
         ticks: u32,
         orbit_rate_radps: f32,
-        sample: impl FnMut(u32) -> Option<[f32; 3]>,
+        sample: impl Fn(u32) -> Option<[f32; 3]>,
     ) {
         let mut r = Run::new();
         run(m, &mut r, ticks, orbit_rate_radps, sample);
@@ -357,7 +373,7 @@ mod bench {
         }
         let st = &r.rest;
         defmt::info!(
-            "{=str}: part Rest (validation, estimator, sequencer, health, output): median {=u32}, worst {=u32}, mean {=u32}, share {=u32}.{=u32} %",
+            "{=str}: part Rest (validation, estimator, sequencer, tension loop, health, output): median {=u32}, worst {=u32}, mean {=u32}, share {=u32}.{=u32} %",
             name,
             st.median(),
             st.max.0,

@@ -1,7 +1,8 @@
 //! # trace_step: the paper mission's steps, one call each, for instruction traces
 //!
 //! Flies `Controller<f32>` (`Config::flight`: the law on the onboard estimator) over the whole 20-hour paper mission (`tss_reel::recordings::mission`)
-//! with one `Controller::step` call per tick and nothing else, so that an execution trace of
+//! with one `Controller::step` call per tick and nothing else (the load cell reading the
+//! recorded state's tension, `tss_reel::recordings::load_cell`, as in `examples/bench_step.rs`), so that an execution trace of
 //! QEMU (`tools/trace_profile.py --mission-tick N`) can attribute the instructions of any
 //! mission step, not only those of the firmware's 720-s replay. Prints nothing per step.
 //!
@@ -20,12 +21,14 @@ use tss_reel::recordings::mission;
 fn main() -> ! {
     use core::hint::black_box;
     use tss_reel::controller::{Config, Controller, Input};
+    use tss_reel::recordings::load_cell;
 
     // The flight configuration (the law on the onboard estimator), as bench_step's figures.
     let Ok(mut ctl) = Controller::new(Config::<f32>::flight()) else {
         defmt::error!("the flight configuration was rejected");
         exit::failure();
     };
+    let cfg = *ctl.config();
     for tick in 0..mission::TICKS {
         let Some(s) = mission::sample(tick) else {
             black_box(ctl.step_missing(tick));
@@ -35,7 +38,13 @@ fn main() -> ! {
             tick,
             length_m: s[0],
             reel_rate_mps: None,
-            tension_n: None,
+            tension_n: load_cell::tension_n(
+                mission::sample,
+                tick,
+                cfg.period_s,
+                &cfg.masses,
+                mission::ORBIT_RATE_RADPS,
+            ),
             alpha_rad: Some(s[1]),
             alpha_rate_radps: Some(s[2]),
             orbit_rate_radps: mission::ORBIT_RATE_RADPS,

@@ -8,11 +8,14 @@
 //! - [`mission`]: the whole 20 hours, recorded every 5 s and interpolated back to 1 s: the
 //!   benchmarks (target and desk) and the accuracy test;
 //! - [`sensors`]: [`replay`] as the reel MCU's sensors ([`crate::hal`] traits, with the
-//!   dropout): the outer law's sensor source of both firmwares (QEMU and NUCLEO-G474RE).
+//!   dropout): the outer law's sensor source of both firmwares (QEMU and NUCLEO-G474RE);
+//! - [`load_cell`]: the tension at the reel in a recorded state (Eq. 5a), the load cell the
+//!   benchmarks give the flight configuration's tension loop.
 //!
 //! Feature `recordings` (on by default). Data, and the one device that reads it; nothing here is linked into
 //! a program that does not use it.
 
+pub mod load_cell;
 pub mod mission;
 pub mod replay;
 pub mod sensors;
