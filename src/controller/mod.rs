@@ -217,8 +217,8 @@ struct Solved<T> {
     reduced_length_m: T,
     /// The Eq. 29 blend weight E.
     blend_weight: T,
-    /// The state of Eq. 5a's free tension, for the protection (`None`: no protection).
-    free_tension: Option<FreeTensionModel<T>>,
+    /// The state of Eq. 5a's free tension, for the protection.
+    free_tension: FreeTensionModel<T>,
 }
 
 /// The law's demand after the tension loop (docs/equations.md §17): shaped to what the tether
@@ -637,10 +637,7 @@ impl<T: Real> Controller<T> {
             mu3,
             reduced_length_m: solution.reduced_length_m,
             blend_weight: input.blend.weight,
-            free_tension: self
-                .protection
-                .is_some()
-                .then(|| FreeTensionModel::of(&input, &solution)),
+            free_tension: FreeTensionModel::of(&input, &solution),
         })
     }
 
@@ -697,13 +694,7 @@ impl<T: Real> Controller<T> {
     ) -> Decided<T> {
         let (l, dt) = (s.input.length_m, self.cfg.period_s);
         let previous = self.last_command.rate_mps;
-        let bounds = self.bounds(solved.free_tension.as_ref(), previous);
-        // With the tension loop, the protection's floor gives way to the attitude as the loop's
-        // window does (docs/equations.md §17.5).
-        let bounds = match &self.tension {
-            Some(t) => t.share_bounds(bounds, previous, dt),
-            None => bounds,
-        };
+        let bounds = self.bounds(Some(&solved.free_tension), previous, true);
         let demand = shaped.demand;
         let (rate_mps, accel_mps2, sat) =
             self.envelope
@@ -730,11 +721,22 @@ impl<T: Real> Controller<T> {
 
     /// The protection's bounds of this step, from the law's state `model` (`None` when the law
     /// did not run: the model is stale, the free tension the load cell's own); none without a
-    /// protection.
-    fn bounds(&mut self, model: Option<&FreeTensionModel<T>>, previous_mps: T) -> Bounds<T> {
-        match &mut self.protection {
-            Some(p) => p.bounds(model, previous_mps, self.cfg.period_s),
-            None => Bounds::none(),
+    /// protection. `shared`: the law's command, whose floor gives way to the attitude as the
+    /// tension loop's window does (docs/equations.md §17.5), when there is a tension loop.
+    fn bounds(
+        &mut self,
+        model: Option<&FreeTensionModel<T>>,
+        previous_mps: T,
+        shared: bool,
+    ) -> Bounds<T> {
+        let dt = self.cfg.period_s;
+        let Some(p) = &mut self.protection else {
+            return Bounds::none();
+        };
+        let bounds = p.bounds(model, previous_mps, dt);
+        match &self.tension {
+            Some(t) if shared => t.share_bounds(bounds, previous_mps, dt),
+            _ => bounds,
         }
     }
 
@@ -794,7 +796,7 @@ impl<T: Real> Controller<T> {
             }
         };
         let length_m = self.length.length_m().unwrap_or(T::ZERO);
-        let bounds = self.bounds(None, previous);
+        let bounds = self.bounds(None, previous, false);
         let (rate_mps, sat) = self
             .envelope
             .limit_request(target, previous, length_m, dt, &bounds);
