@@ -447,7 +447,7 @@ mod board {
                 let mut inner = INNER.borrow(cs).try_borrow_mut().ok()?;
                 inner.as_mut().map(|i| {
                     i.pending = if finished { Some(hold) } else { cmd };
-                    *i.drive.output()
+                    i.drive.output()
                 })
             });
 
@@ -501,7 +501,7 @@ mod board {
                         let _ = inner.drive.set_command(cmd, tick);
                     }
                     let _ = inner.drive.tick(tick);
-                    inner.period_faults = inner.period_faults.union(inner.drive.output().faults);
+                    inner.period_faults = inner.period_faults.union(inner.drive.speed_loop().faults());
                 }
             }
         });

@@ -103,7 +103,7 @@ impl<'a> Reel<'a> {
     #[inline(never)]
     pub fn tick(&mut self, tick: u32) {
         let _ = self.drive.tick(tick);
-        self.period_faults = self.period_faults.union(self.drive.output().faults);
+        self.period_faults = self.period_faults.union(self.drive.speed_loop().faults());
         if let Ok(mut drum) = self.drum.try_borrow_mut() {
             drum.advance(INNER_PERIOD_MS as f32 * 1e-3);
         }

@@ -24,7 +24,7 @@ use embedded_hal::pwm::SetDutyCycle;
 
 pub use crate::hal::{Error, ErrorKind, ErrorType};
 
-use super::{DriveFault, DriveOutput, RateCommand, SpeedLoop};
+use super::{DriveFault, DriveOutput, MotorCommand, RateCommand, SpeedLoop};
 
 /// The drum's quadrature encoder: a free-running hardware counter (a timer in encoder mode).
 pub trait QuadratureEncoder: ErrorType {
@@ -156,12 +156,12 @@ where
     pub fn tick(&mut self, tick: u32) -> DriveCycle {
         let count = self.encoder.read_count().map_err(|e| e.kind());
         let tension = self.load_cell.read_tension_n().map_err(|e| e.kind());
-        let out = *self.speed.step(&super::DriveInput {
+        self.speed.step(&super::DriveInput {
             tick,
             encoder_count: count.ok(),
             tension_n: tension.ok(),
         });
-        let actuator_error = self.apply(&out).err();
+        let actuator_error = self.apply(self.speed.motor()).err();
         if actuator_error.is_some() {
             self.speed.trip(DriveFault::Actuator);
             // Best effort: the first error is the one reported.
@@ -174,8 +174,9 @@ where
         }
     }
 
-    /// The speed loop's last output (what the outputs were set to).
-    pub fn output(&self) -> &DriveOutput {
+    /// The speed loop's last output (what the outputs were set to), worked out when asked
+    /// ([`SpeedLoop::output`]).
+    pub fn output(&self) -> DriveOutput {
         self.speed.output()
     }
 
@@ -197,7 +198,7 @@ where
     /// Sets the outputs for `out`: with the motor enabled, enable, the brake (released, or
     /// engaged while the motor holds a slipping brake), then direction (after a zero duty if
     /// it reverses) and duty; otherwise duty 0, driver off, brake engaged, in that order.
-    fn apply(&mut self, out: &DriveOutput) -> Result<(), ActuatorError> {
+    fn apply(&mut self, out: MotorCommand) -> Result<(), ActuatorError> {
         if !out.brake.motor_enabled() {
             return self.safe_state();
         }

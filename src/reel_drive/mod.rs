@@ -29,7 +29,7 @@
 //!    and the duty is τ / τ_max, saturated at ± [`DriveConfig::duty_limit`]. Anti-windup is
 //!    **conditional integration**: the integral does not grow while the output is saturated and
 //!    the error pushes it further into saturation; it is also bounded to ± τ_max.
-//! 5. **Faults** ([`DriveFault`]), reported in every [`DriveOutput`]; the ones that leave the
+//! 5. **Faults** ([`DriveFault`]), returned by every step; the ones that leave the
 //!    drum uncontrolled (no encoder, a stalled motor, a drum that does not answer the torque,
 //!    a failed actuator) trip the drive: motor off, brake on, until [`SpeedLoop::clear_trip`].
 //!    Besides each reading's own checks, the drive cross-checks its sensors against each other
@@ -48,7 +48,9 @@
 //! // The law asks for 0.1 m/s (its first deployment command, Eq. 29).
 //! drive.set_command(RateCommand { rate_mps: 0.1, accel_mps2: 0.0, safe_hold: false }, 0);
 //! let input = |tick| DriveInput { tick, encoder_count: Some(0), tension_n: Some(20.0) };
-//! assert!(matches!(drive.step(&input(0)).brake, Brake::Releasing { .. }));
+//! // A step returns its faults; the motor's command and the telemetry are read from the loop.
+//! assert!(drive.step(&input(0)).is_empty());
+//! assert!(matches!(drive.motor().brake, Brake::Releasing { .. }));
 //! // While the brake lifts, the motor takes over the tension's torque (−T r = −2 N m of 5).
 //! assert!((drive.output().duty - (-0.4)).abs() < 1e-6);
 //! for tick in 1..=50 {
@@ -104,9 +106,19 @@ pub struct DriveInput {
     pub tension_n: Option<f32>,
 }
 
-/// What one inner step decided: the reference, the measurements it used, the duty and the
-/// brake. (The torque's parts are worked out on demand, [`SpeedLoop::torque_parts`], not every
-/// tick.)
+/// What the hardware is set to after a step ([`SpeedLoop::motor`]): the motor's duty and the
+/// brake, which also says whether the motor is enabled.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct MotorCommand {
+    /// Motor duty in [−duty_limit, duty_limit] (sign = direction, pay-out positive).
+    pub duty: f32,
+    /// The brake (and motor enable).
+    pub brake: Brake,
+}
+
+/// The last step's telemetry ([`SpeedLoop::output`]): the reference, the measurements it used,
+/// the duty and the brake. (The torque's parts: [`SpeedLoop::torque_parts`].)
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct DriveOutput {
@@ -133,21 +145,6 @@ pub struct DriveOutput {
     pub faults: DriveFaults,
 }
 
-impl DriveOutput {
-    const IDLE: Self = Self {
-        tick: 0,
-        ref_rate_mps: 0.0,
-        ref_accel_mps2: 0.0,
-        speed_mps: 0.0,
-        tension_n: 0.0,
-        torque_nm: 0.0,
-        duty: 0.0,
-        saturated: false,
-        brake: Brake::Engaged,
-        faults: DriveFaults::NONE,
-    };
-}
-
 /// The parts the last step's torque was made of (telemetry: [`SpeedLoop::torque_parts`]).
 /// Their sum is [`DriveOutput::torque_nm`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -167,11 +164,9 @@ pub struct TorqueParts {
     pub ff_friction_nm: f32,
 }
 
-/// What the step drives the motor with: the reference, the torque asked for and its duty.
+/// What the step drives the motor with: the torque asked for and its duty.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Drive {
-    ref_mps: f32,
-    ref_accel_mps2: f32,
     torque_nm: f32,
     duty: f32,
     saturated: bool,
@@ -180,8 +175,6 @@ struct Drive {
 impl Drive {
     /// The motor off.
     const OFF: Self = Self {
-        ref_mps: 0.0,
-        ref_accel_mps2: 0.0,
         torque_nm: 0.0,
         duty: 0.0,
         saturated: false,
@@ -241,10 +234,17 @@ pub struct SpeedLoop {
     last_tick: Option<u32>,
     /// The load cell's last usable tension (a reading in range, or clamped into it), N.
     load_cell_n: f32,
-    /// The duty the motor applies until the next step (the last step's), and whether it was
-    /// saturated.
+    /// The duty the motor applies until the next step (the last step's), whether it was
+    /// saturated, and the torque it was asked for, N m.
     duty: f32,
     saturated: bool,
+    torque_nm: f32,
+    /// The last step's reference (v_ref m/s, a_ref m/s²) while the brake is free.
+    reference: (f32, f32),
+    /// The tension the last step's feed-forward used (0 once the load cell is not trusted), N.
+    tension_n: f32,
+    /// The last step's faults.
+    faults: DriveFaults,
     integral_nm: f32,
     stall_ticks: u32,
     /// Ticks of duty saturation left before [`DriveFault::DutySaturated`] is reported (the
@@ -252,9 +252,6 @@ pub struct SpeedLoop {
     saturation_left_ticks: u32,
     /// The cross-checks' state.
     checks: CrossChecks,
-    /// The last step's output, as reported (with the brake and duty after a
-    /// [`trip`](Self::trip) or [`clear_trip`](Self::clear_trip) since).
-    out: DriveOutput,
 }
 
 impl SpeedLoop {
@@ -301,11 +298,14 @@ impl SpeedLoop {
             load_cell_n: 0.0,
             duty: 0.0,
             saturated: false,
+            torque_nm: 0.0,
+            reference: (0.0, 0.0),
+            tension_n: 0.0,
+            faults: DriveFaults::NONE,
             integral_nm: 0.0,
             stall_ticks: 0,
             saturation_left_ticks: cfg.faults.saturation_ticks,
             checks: CrossChecks::START,
-            out: DriveOutput::IDLE,
         })
     }
 
@@ -314,10 +314,43 @@ impl SpeedLoop {
         &self.cfg
     }
 
-    /// The last step's output (with the brake's state after a [`trip`](Self::trip) or
-    /// [`clear_trip`](Self::clear_trip) since).
-    pub fn output(&self) -> &DriveOutput {
-        &self.out
+    /// The last step's telemetry (with the brake, duty and speed after a [`trip`](Self::trip)
+    /// or [`clear_trip`](Self::clear_trip) since). Worked out when asked: the step itself keeps
+    /// only what the next step needs and what it cannot work out again (the torque, the
+    /// reference and the tension it used).
+    pub fn output(&self) -> DriveOutput {
+        let (ref_rate_mps, ref_accel_mps2) = match self.brake {
+            Brake::Released { .. } => self.reference,
+            Brake::Engaged | Brake::Releasing { .. } | Brake::MotorHold | Brake::Tripped(_) => {
+                (0.0, 0.0)
+            }
+        };
+        DriveOutput {
+            tick: self.last_tick.unwrap_or(0),
+            ref_rate_mps,
+            ref_accel_mps2,
+            speed_mps: self.odometer.speed_mps(),
+            tension_n: self.tension_n,
+            torque_nm: self.torque_nm,
+            duty: self.duty,
+            saturated: self.saturated,
+            brake: self.brake,
+            faults: self.faults,
+        }
+    }
+
+    /// What the hardware is to be set to: the last step's duty and the brake (after a
+    /// [`trip`](Self::trip) or [`clear_trip`](Self::clear_trip) since, the motor off).
+    pub fn motor(&self) -> MotorCommand {
+        MotorCommand {
+            duty: self.duty,
+            brake: self.brake,
+        }
+    }
+
+    /// The last step's faults ([`DriveOutput::faults`], without the rest of the telemetry).
+    pub fn faults(&self) -> DriveFaults {
+        self.faults
     }
 
     /// The odometer (total count, paid-out length, speed).
@@ -346,7 +379,7 @@ impl SpeedLoop {
     /// the brake free or the motor holding, PI and the three feed-forwards; while it lifts,
     /// only the tension's; otherwise none.
     pub fn torque_parts(&self) -> TorqueParts {
-        let o = &self.out;
+        let o = &self.output();
         match o.brake {
             Brake::Released { .. } | Brake::MotorHold => {
                 let error_mps = o.ref_rate_mps - o.speed_mps;
@@ -410,9 +443,7 @@ impl SpeedLoop {
             self.duty = 0.0;
             self.saturated = false;
             self.integral_nm = 0.0;
-            self.out.brake = self.brake;
-            self.out.duty = 0.0;
-            self.out.saturated = false;
+            self.torque_nm = 0.0;
         }
     }
 
@@ -439,11 +470,9 @@ impl SpeedLoop {
             }
         };
         self.brake = Brake::Engaged;
-        self.out.brake = Brake::Engaged;
-        self.out.duty = 0.0;
-        self.out.saturated = false;
         self.duty = 0.0;
         self.saturated = false;
+        self.torque_nm = 0.0;
         self.integral_nm = 0.0;
         self.stall_ticks = 0;
         self.saturation_left_ticks = self.cfg.faults.saturation_ticks;
@@ -454,9 +483,13 @@ impl SpeedLoop {
         Some(cleared)
     }
 
-    /// One inner tick: odometry, brake, reference, PI + feed-forward, faults. The duty and
-    /// brake in the output are what the hardware is to be set to.
-    pub fn step(&mut self, input: &DriveInput) -> &DriveOutput {
+    /// One inner tick: odometry, brake, reference, PI + feed-forward, faults. Returns the
+    /// step's faults; what the hardware is to be set to is [`motor`](Self::motor), the
+    /// telemetry [`output`](Self::output). Only the faults come back: a returned struct goes
+    /// through memory and costs the step some 13 instructions, and each value written back at
+    /// the step's end is one more kept alive through it (the ten of the telemetry cost some
+    /// 17, `scripts/bench-target`).
+    pub fn step(&mut self, input: &DriveInput) -> DriveFaults {
         let tick = input.tick;
         // Integer time: the tick must advance (wrapping, by less than half the range); the
         // first step's gap is one tick.
@@ -482,6 +515,7 @@ impl SpeedLoop {
         } else {
             0.0
         };
+        self.tension_n = tension_n;
         // Its torque at the drum, T r, N m (the feed-forward's, the observer's start, the
         // judgement's).
         let tether_nm = tension_n * self.cfg.geometry.drum_radius_m;
@@ -494,9 +528,10 @@ impl SpeedLoop {
         let drive = match self.brake {
             Brake::Released { rest_ticks } => {
                 let (ref_mps, ref_accel_mps2) = self.reference_at(tick);
+                self.reference = (ref_mps, ref_accel_mps2);
                 let torque_nm =
                     self.speed_law(ref_mps, ref_accel_mps2, gap_ticks, speed_mps, tether_nm);
-                let drive = self.driven(ref_mps, ref_accel_mps2, torque_nm);
+                let drive = self.driven(torque_nm);
                 if !counted {
                     // No measured motion: the checks neither count this tick nor clear.
                     drive
@@ -518,11 +553,11 @@ impl SpeedLoop {
                 faults.insert(DriveFault::BrakeSlip);
                 self.stall_ticks = 0;
                 let torque_nm = self.speed_law(0.0, 0.0, gap_ticks, speed_mps, tether_nm);
-                self.driven(0.0, 0.0, torque_nm)
+                self.driven(torque_nm)
             }
             Brake::Releasing { .. } => {
                 self.stall_ticks = 0;
-                self.driven(0.0, 0.0, -tether_nm)
+                self.driven(-tether_nm)
             }
             Brake::Engaged => {
                 self.stall_ticks = 0;
@@ -558,28 +593,18 @@ impl SpeedLoop {
 
         self.duty = drive.duty;
         self.saturated = drive.saturated;
-        self.out = DriveOutput {
-            tick,
-            ref_rate_mps: drive.ref_mps,
-            ref_accel_mps2: drive.ref_accel_mps2,
-            speed_mps,
-            tension_n,
-            torque_nm: drive.torque_nm,
-            duty: drive.duty,
-            saturated: drive.saturated,
-            brake: self.brake,
-            faults,
-        };
-        &self.out
+        self.torque_nm = drive.torque_nm;
+        self.faults = faults;
+        faults
     }
 
-    /// A tick that did not advance: nothing is done, the last output stands, with
+    /// A tick that did not advance: nothing is done, the motor and brake stay as they are, with
     /// [`DriveFault::Tick`].
-    fn reject_tick(&mut self) -> &DriveOutput {
+    fn reject_tick(&mut self) -> DriveFaults {
         let mut faults = self.command_faults;
         faults.insert(DriveFault::Tick);
-        self.out.faults = faults;
-        &self.out
+        self.faults = faults;
+        faults
     }
 
     /// Tether paid out since the first encoder reading, m (a function of the integer count).
@@ -669,13 +694,11 @@ impl SpeedLoop {
         }
     }
 
-    /// The drive of a torque: the reference, the torque and its duty.
-    fn driven(&self, ref_mps: f32, ref_accel_mps2: f32, torque_nm: f32) -> Drive {
+    /// The drive of a torque: the torque and its duty.
+    fn driven(&self, torque_nm: f32) -> Drive {
         let (duty, saturated) =
             saturate(torque_nm * self.derived.per_max_torque, self.cfg.duty_limit);
         Drive {
-            ref_mps,
-            ref_accel_mps2,
             torque_nm,
             duty,
             saturated,
@@ -830,14 +853,18 @@ mod tests {
             tension_n: Some(200.0),
         };
         let mut tick = 0;
-        while !matches!(s.step(&input(tick, Some(0))).brake, Brake::Released { .. }) {
+        loop {
+            s.step(&input(tick, Some(0)));
+            if matches!(s.brake(), Brake::Released { .. }) {
+                break;
+            }
             tick += 1;
         }
         let counted = s.stall_ticks;
         assert!(counted > 0);
         tick += 1;
-        let out = *s.step(&input(tick, None));
-        assert!(out.faults.contains(DriveFault::EncoderMissing));
+        let faults = s.step(&input(tick, None));
+        assert!(faults.contains(DriveFault::EncoderMissing));
         assert_eq!(s.stall_ticks, counted);
         tick += 1;
         s.step(&input(tick, Some(0)));
@@ -881,12 +908,12 @@ mod tests {
             (s.brake(), s.output().brake),
             (Brake::Engaged, Brake::Engaged)
         );
-        let out = *s.step(&DriveInput {
+        let faults = s.step(&DriveInput {
             tick: 0,
             encoder_count: Some(0),
             tension_n: Some(20.0),
         });
-        assert_eq!((out.brake, out.duty), (Brake::Engaged, 0.0));
-        assert!(out.faults.is_empty());
+        assert_eq!(s.motor(), MotorCommand { duty: 0.0, brake: Brake::Engaged });
+        assert!(faults.is_empty());
     }
 }

@@ -117,11 +117,12 @@ mod tests {
     impl Follower {
         fn step(&mut self, tick: u32) -> Brake {
             let count = (self.travel_m / self.m_per_count).floor() as i64 as u32;
-            let out = *self.s.step(&DriveInput {
+            self.s.step(&DriveInput {
                 tick,
                 encoder_count: Some(count),
                 tension_n: Some(20.0),
             });
+            let out = self.s.output();
             self.travel_m += f64::from(out.ref_rate_mps) * 1e-3;
             out.brake
         }

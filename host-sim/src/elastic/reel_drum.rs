@@ -290,11 +290,12 @@ impl FlightDrum {
     /// [`FlightDrum::end_tick`] once the drum has moved.
     pub fn start_tick(&mut self, angle_rad: f64, tension_n: f64) -> (f64, bool) {
         use tss_reel::reel_drive::DriveInput;
-        let out = *self.speed.step(&DriveInput {
+        self.speed.step(&DriveInput {
             tick: self.tick,
             encoder_count: Some(self.encoder_count(angle_rad)),
             tension_n: Some(tension_n as f32),
         });
+        let out = self.speed.motor();
         self.note_tension(tension_n);
         let brake = !out.brake.brake_released();
         let motor_nm = (f64::from(out.duty) * self.torque_per_duty_nm)
@@ -306,7 +307,7 @@ impl FlightDrum {
     /// at its end: the tracking, saturation and fault figures. Returns |drum speed − reference|
     /// with the brake released, m/s.
     pub fn end_tick(&mut self, speed_mps: f64) -> Option<f64> {
-        let out = *self.speed.output();
+        let out = self.speed.output();
         let f = &mut self.figures;
         f.ticks += 1;
         f.saturated_ticks += u64::from(out.saturated);
