@@ -501,7 +501,8 @@ mod board {
                         let _ = inner.drive.set_command(cmd, tick);
                     }
                     let _ = inner.drive.tick(tick);
-                    inner.period_faults = inner.period_faults.union(inner.drive.speed_loop().faults());
+                    inner.period_faults =
+                        inner.period_faults.union(inner.drive.speed_loop().faults());
                 }
             }
         });

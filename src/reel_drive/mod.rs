@@ -913,7 +913,13 @@ mod tests {
             encoder_count: Some(0),
             tension_n: Some(20.0),
         });
-        assert_eq!(s.motor(), MotorCommand { duty: 0.0, brake: Brake::Engaged });
+        assert_eq!(
+            s.motor(),
+            MotorCommand {
+                duty: 0.0,
+                brake: Brake::Engaged
+            }
+        );
         assert!(faults.is_empty());
     }
 }
