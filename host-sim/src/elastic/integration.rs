@@ -1,16 +1,16 @@
 //! The integration of the truth model: its state vector, the time derivative (gravity relative
 //! to the reference particle, the tether's segments, drag, the momentum flux at the reel, the
-//! drum and its speed loop) and the classical RK4 step over it (see the module doc of `mod.rs`).
+//! drum and its speed loop) and the classical RK4 step over it (see the module doc of `mod.rs`),
+//! written for a second-order system: a position's rate at a stage is that stage's velocity, so
+//! the step needs the accelerations only (Runge–Kutta–Nyström form of the same method).
 
-use super::environment::{
-    air_velocity_mps, altitude_m, body_drag_n, cylinder_drag_n, AirSample, Vec3,
-};
+use super::environment::{air_velocity_mps, body_drag_n, cylinder_drag_n, Vec3};
 use super::params::ElasticParams;
 use super::reel_drum::{DrumParams, Motion};
 use super::tether::Layout;
 
 /// The integrated state: the reference particle, the reel, and every node relative to the
-/// reference (inertial axes). Also the shape of its time derivative.
+/// reference (inertial axes).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub(super) struct State {
     /// Reference particle's position R and velocity V (inertial), m, m/s.
@@ -27,20 +27,51 @@ pub(super) struct State {
     pub(super) vel: Vec<Vec3>,
 }
 
+/// The time derivative of a [`State`] but for the positions' rates (the velocities).
+#[derive(Clone, Debug, Default)]
+pub(super) struct Rates {
+    /// The reference particle's acceleration, m/s².
+    accel_ref: Vec3,
+    /// l̇, m/s.
+    paid_out_mps: f64,
+    /// ω̇, rad/s².
+    drum_accel_radps2: f64,
+    /// The speed loop's integrator rate, rad/s.
+    drum_integral_radps: f64,
+    /// Node accelerations ρ̈_i, m/s².
+    accel: Vec<Vec3>,
+}
+
 impl State {
-    /// `self = y + c·k` (same node count).
-    pub(super) fn set_stage(&mut self, y: &State, c: f64, k: &State) {
-        self.r_ref = y.r_ref + k.r_ref * c;
-        self.v_ref = y.v_ref + k.v_ref * c;
-        self.paid_out_m = y.paid_out_m + k.paid_out_m * c;
-        self.drum_speed_radps = y.drum_speed_radps + k.drum_speed_radps * c;
-        self.drum_integral_rad = y.drum_integral_rad + k.drum_integral_rad * c;
+    /// `self` = a stage of the RK4 step from `y`, `tau` into it: the velocities and the
+    /// first-order quantities advanced by `tau`·`k`; the positions by `tau`·(`y`'s velocities)
+    /// plus `c`·(the accelerations `a`) for `curve` = Some((c, a)). With the stages' rates
+    /// k_1…k_4, RK4 for ρ̇ = v, v̇ = a(ρ, v) is ρ_2 = ρ + (h/2)v, ρ_3 = ρ + (h/2)v + (h²/4)a_1,
+    /// ρ_4 = ρ + hv + (h²/2)a_2, v_j = v + c_j h a_(j−1).
+    fn set_stage(&mut self, y: &State, tau: f64, k: &Rates, curve: Option<(f64, &Rates)>) {
+        let (c, a_ref) = curve.map_or((0.0, Vec3::zeros()), |(c, a)| (c, a.accel_ref));
+        self.r_ref = y.r_ref + y.v_ref * tau + a_ref * c;
+        self.v_ref = y.v_ref + k.accel_ref * tau;
+        self.paid_out_m = y.paid_out_m + k.paid_out_mps * tau;
+        self.drum_speed_radps = y.drum_speed_radps + k.drum_accel_radps2 * tau;
+        self.drum_integral_rad = y.drum_integral_rad + k.drum_integral_radps * tau;
         let n = y.pos.len();
         self.pos.resize(n, Vec3::zeros());
         self.vel.resize(n, Vec3::zeros());
         for i in 0..n {
-            self.pos[i] = y.pos[i] + k.pos[i] * c;
-            self.vel[i] = y.vel[i] + k.vel[i] * c;
+            self.vel[i] = y.vel[i] + k.accel[i] * tau;
+        }
+        match curve {
+            None => {
+                for i in 0..n {
+                    self.pos[i] = y.pos[i] + y.vel[i] * tau;
+                }
+            }
+            Some((c, a)) => {
+                for i in 0..n {
+                    self.pos[i] = y.pos[i] + y.vel[i] * tau + a.accel[i] * c;
+                }
+            }
         }
     }
 
@@ -138,103 +169,125 @@ pub(super) fn motor_torque(
 /// Preallocated buffers of one RK4 step.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Workspace {
-    k: [State; 4],
+    k: [Rates; 4],
     stage: State,
     /// The nodes' masses (a buffer the plant borrows between steps too).
     pub(super) masses: Vec<f64>,
-    air: AirCache,
+    drag: HeldDrag,
 }
 
-/// The atmosphere at the segments' midpoints (0…n − 2) and the end bodies (n − 1, n) over one
-/// substep: sampled (one `exp` each) at its first stage, the later stages' densities continued
-/// from those samples ([`AirSample::density_kgpm3_at`], exact to 2e-15) instead of four
-/// `exp` per segment and substep.
-#[derive(Clone, Debug, Default)]
-struct AirCache {
-    samples: Vec<AirSample>,
-    /// Take new samples at this evaluation (the substep's first stage).
-    resample: bool,
-}
-
-impl AirCache {
-    /// The density at `r` for the sample slot `k`, kg/m³.
-    #[inline]
-    fn density_kgpm3(&mut self, k: usize, r: &Vec3) -> f64 {
-        let h = altitude_m(r);
-        if self.resample {
-            self.samples[k] = AirSample::at(h);
-            self.samples[k].density_kgpm3
-        } else {
-            self.samples[k].density_kgpm3_at(h)
-        }
+impl Workspace {
+    /// A control period starts: the drag is evaluated again at the next step.
+    pub(super) fn resample_drag(&mut self) {
+        self.drag.stale = true;
     }
 }
 
-/// The time derivative of `y` (see the module doc) into `dy`.
+/// The drag on every node over one control period, N: evaluated at the period's start (the
+/// atmosphere sampled there, one `exp` per segment and body) and held over its substeps, or
+/// again after a bead entered or left. Drag is a slow external force — at 700 km about 1e-6 N
+/// per segment against tensions of 0.1–20 N, changing on the orbit's and the librations' time
+/// scales (its rate relative to itself ~1e-3 /s), and damping the tether's modes at ~1e-9 /s —
+/// so holding it over a period changes the answers far below the step's own error
+/// (docs/truth-model.md §1 "Integration").
+#[derive(Clone, Debug, Default)]
+struct HeldDrag {
+    force_n: Vec<Vec3>,
+    /// Evaluate the drag at the next evaluation (a period starts).
+    stale: bool,
+}
+
+/// The drag on every node at `y`, N: half of each segment's cross-flow drag (at its midpoint,
+/// the air co-rotating) on either end, and the end bodies' own.
+fn drag_n(p: &ElasticParams, y: &State, force_n: &mut Vec<Vec3>) {
+    let t = &p.tether;
+    let b = &p.bodies;
+    let env = &p.environment;
+    let n = y.pos.len();
+    force_n.clear();
+    force_n.resize(n, Vec3::zeros());
+    let cd_d = t.drag_coefficient * t.diameter_m;
+    if cd_d > 0.0 {
+        for s in 0..n - 1 {
+            let d = y.pos[s + 1] - y.pos[s];
+            let chord = d.norm();
+            if chord == 0.0 {
+                continue;
+            }
+            let u = d * (1.0 / chord);
+            let mid = y.r_ref + (y.pos[s] + y.pos[s + 1]) * 0.5;
+            let v_air = y.v_ref + (y.vel[s] + y.vel[s + 1]) * 0.5 - air_velocity_mps(&mid);
+            let f = cylinder_drag_n(env.air_density_kgpm3(&mid), cd_d * chord, &u, &v_air) * 0.5;
+            force_n[s] += f;
+            force_n[s + 1] += f;
+        }
+    }
+    for (i, cda) in [(0, b.main_drag_area_m2), (n - 1, b.sub_drag_area_m2)] {
+        let r = y.r_ref + y.pos[i];
+        let v_air = y.v_ref + y.vel[i] - air_velocity_mps(&r);
+        force_n[i] += body_drag_n(env.air_density_kgpm3(&r), cda, &v_air);
+    }
+}
+
+/// The time derivative of `y` (see the module doc) into `dy` (the positions' rates are the
+/// velocities).
 fn derivative(
     p: &ElasticParams,
     layout: &Layout,
     y: &State,
     drive: ReelDrive,
     masses: &mut Vec<f64>,
-    air: &mut AirCache,
-    dy: &mut State,
+    drag: &mut HeldDrag,
+    dy: &mut Rates,
 ) {
     let t = &p.tether;
     let b = &p.bodies;
     let env = &p.environment;
     layout.masses(t, b.main_initial_kg, b.sub_kg, y.paid_out_m, masses);
     let n = masses.len();
-    air.samples.resize(n + 1, AirSample::default());
-    dy.pos.resize(n, Vec3::zeros());
-    dy.vel.resize(n, Vec3::zeros());
+    dy.accel.resize(n, Vec3::zeros());
     let reel_rate = drive.rate_mps(y.drum_speed_radps);
-    dy.r_ref = y.v_ref;
     let g_ref = env.gravity(&y.r_ref);
-    dy.v_ref = g_ref;
-    dy.paid_out_m = reel_rate;
+    dy.accel_ref = g_ref;
+    dy.paid_out_mps = reel_rate;
     // Forces: gravity relative to the reference particle's (exact), then the tether, drag and
     // the momentum flux of the paid-out tether; divided by the masses at the end.
-    for (i, m) in masses.iter().enumerate() {
-        dy.pos[i] = y.vel[i];
-        dy.vel[i] = env.gravity_relative(&y.r_ref, &g_ref, &y.pos[i]) * *m;
+    let (pos, vel, accel) = (&y.pos[..n], &y.vel[..n], &mut dy.accel[..n]);
+    for ((a, p), m) in accel.iter_mut().zip(pos).zip(masses.iter()) {
+        *a = env.gravity_relative(&y.r_ref, &g_ref, p) * *m;
     }
+    // Segment s − 1 pulls node s − 1 towards node s and node s back.
     let mut tension_reel = 0.0;
-    let cd_d = t.drag_coefficient * t.diameter_m;
-    for s in 0..n - 1 {
-        let d = y.pos[s + 1] - y.pos[s];
+    for s in 1..n {
+        let d = pos[s] - pos[s - 1];
         let chord = d.norm();
         if chord == 0.0 {
             continue;
         }
         let u = d * (1.0 / chord);
-        let chord_rate = (y.vel[s + 1] - y.vel[s]).dot(&u);
-        let (l, l_rate) = if s == 0 {
-            (layout.reel_segment_m(t, y.paid_out_m), reel_rate)
+        let chord_rate = (vel[s] - vel[s - 1]).dot(&u);
+        let tension = if s == 1 {
+            tension_reel = t.tension_n(
+                chord,
+                chord_rate,
+                layout.reel_segment_m(t, y.paid_out_m),
+                reel_rate,
+            );
+            tension_reel
         } else {
-            (t.segment_length_m, 0.0)
+            t.tension_n(chord, chord_rate, t.segment_length_m, 0.0)
         };
-        let tension = t.tension_n(chord, chord_rate, l, l_rate);
-        if s == 0 {
-            tension_reel = tension;
-        }
         let f = u * tension;
-        dy.vel[s] += f;
-        dy.vel[s + 1] -= f;
-        if env.drag && cd_d > 0.0 {
-            let mid = y.r_ref + (y.pos[s] + y.pos[s + 1]) * 0.5;
-            let rho_air = air.density_kgpm3(s, &mid);
-            let v_air = y.v_ref + (y.vel[s] + y.vel[s + 1]) * 0.5 - air_velocity_mps(&mid);
-            let f = cylinder_drag_n(rho_air, cd_d * chord, &u, &v_air) * 0.5;
-            dy.vel[s] += f;
-            dy.vel[s + 1] += f;
-        }
+        accel[s - 1] += f;
+        accel[s] -= f;
     }
     if env.drag {
-        for (i, cda) in [(0, b.main_drag_area_m2), (n - 1, b.sub_drag_area_m2)] {
-            let r = y.r_ref + y.pos[i];
-            let v_air = y.v_ref + y.vel[i] - air_velocity_mps(&r);
-            dy.vel[i] += body_drag_n(air.density_kgpm3(n - 1 + i.min(1), &r), cda, &v_air);
+        if drag.stale || drag.force_n.len() != n {
+            drag_n(p, y, &mut drag.force_n);
+            drag.stale = false;
+        }
+        for (v, f) in dy.accel.iter_mut().zip(&drag.force_n) {
+            *v += f;
         }
     }
     // Paying out, ½ρl̇ kg/s of tether joins node 1 at node 0's velocity (winding in, it leaves
@@ -242,14 +295,14 @@ fn derivative(
     // q·(v_donor − v_receiver), the donor's velocity not at all.
     let q = 0.5 * t.density_kg_per_m * reel_rate;
     if q > 0.0 {
-        dy.vel[1] += (y.vel[0] - y.vel[1]) * q;
+        dy.accel[1] += (y.vel[0] - y.vel[1]) * q;
     } else if q < 0.0 {
-        dy.vel[0] += (y.vel[1] - y.vel[0]) * (-q);
+        dy.accel[0] += (y.vel[1] - y.vel[0]) * (-q);
     }
-    for (v, m) in dy.vel.iter_mut().zip(masses.iter()) {
+    for (v, m) in dy.accel.iter_mut().zip(masses.iter()) {
         *v *= 1.0 / *m;
     }
-    (dy.drum_speed_radps, dy.drum_integral_rad) = match drive {
+    (dy.drum_accel_radps2, dy.drum_integral_radps) = match drive {
         ReelDrive::Rate(_) => (0.0, 0.0),
         ReelDrive::Drum {
             drum: d,
@@ -296,58 +349,41 @@ pub(super) fn rk4_step(
     ws: &mut Workspace,
 ) {
     let [k1, k2, k3, k4] = &mut ws.k;
-    ws.air.resample = true;
-    derivative(p, layout, y, drives[0], &mut ws.masses, &mut ws.air, k1);
-    ws.air.resample = false;
-    ws.stage.set_stage(y, 0.5 * h, k1);
-    derivative(
-        p,
-        layout,
-        &ws.stage,
-        drives[1],
-        &mut ws.masses,
-        &mut ws.air,
-        k2,
-    );
-    ws.stage.set_stage(y, 0.5 * h, k2);
-    derivative(
-        p,
-        layout,
-        &ws.stage,
-        drives[1],
-        &mut ws.masses,
-        &mut ws.air,
-        k3,
-    );
-    ws.stage.set_stage(y, h, k3);
-    derivative(
-        p,
-        layout,
-        &ws.stage,
-        drives[2],
-        &mut ws.masses,
-        &mut ws.air,
-        k4,
-    );
+    let (masses, drag, stage) = (&mut ws.masses, &mut ws.drag, &mut ws.stage);
+    derivative(p, layout, y, drives[0], masses, drag, k1);
+    stage.set_stage(y, 0.5 * h, k1, None);
+    derivative(p, layout, stage, drives[1], masses, drag, k2);
+    stage.set_stage(y, 0.5 * h, k2, Some((0.25 * h * h, k1)));
+    derivative(p, layout, stage, drives[1], masses, drag, k3);
+    stage.set_stage(y, h, k3, Some((0.5 * h * h, k2)));
+    derivative(p, layout, stage, drives[2], masses, drag, k4);
+    // ρ ← ρ + hv + (h²/6)(a_1 + a_2 + a_3), v ← v + (h/6)(a_1 + 2a_2 + 2a_3 + a_4).
     let c = h / 6.0;
+    let c_pos = h * c;
     let comb = |a: f64, b: f64, d: f64, e: f64| (a + 2.0 * b + 2.0 * d + e) * c;
-    y.r_ref += (k1.r_ref + k2.r_ref * 2.0 + k3.r_ref * 2.0 + k4.r_ref) * c;
-    y.v_ref += (k1.v_ref + k2.v_ref * 2.0 + k3.v_ref * 2.0 + k4.v_ref) * c;
-    y.paid_out_m += comb(k1.paid_out_m, k2.paid_out_m, k3.paid_out_m, k4.paid_out_m);
+    y.r_ref += y.v_ref * h + (k1.accel_ref + k2.accel_ref + k3.accel_ref) * c_pos;
+    y.v_ref += (k1.accel_ref + (k2.accel_ref + k3.accel_ref) * 2.0 + k4.accel_ref) * c;
+    y.paid_out_m += comb(
+        k1.paid_out_mps,
+        k2.paid_out_mps,
+        k3.paid_out_mps,
+        k4.paid_out_mps,
+    );
     y.drum_speed_radps += comb(
-        k1.drum_speed_radps,
-        k2.drum_speed_radps,
-        k3.drum_speed_radps,
-        k4.drum_speed_radps,
+        k1.drum_accel_radps2,
+        k2.drum_accel_radps2,
+        k3.drum_accel_radps2,
+        k4.drum_accel_radps2,
     );
     y.drum_integral_rad += comb(
-        k1.drum_integral_rad,
-        k2.drum_integral_rad,
-        k3.drum_integral_rad,
-        k4.drum_integral_rad,
+        k1.drum_integral_radps,
+        k2.drum_integral_radps,
+        k3.drum_integral_radps,
+        k4.drum_integral_radps,
     );
     for i in 0..y.pos.len() {
-        y.pos[i] += (k1.pos[i] + k2.pos[i] * 2.0 + k3.pos[i] * 2.0 + k4.pos[i]) * c;
-        y.vel[i] += (k1.vel[i] + k2.vel[i] * 2.0 + k3.vel[i] * 2.0 + k4.vel[i]) * c;
+        let (a1, a2, a3, a4) = (k1.accel[i], k2.accel[i], k3.accel[i], k4.accel[i]);
+        y.pos[i] += y.vel[i] * h + (a1 + a2 + a3) * c_pos;
+        y.vel[i] += (a1 + (a2 + a3) * 2.0 + a4) * c;
     }
 }

@@ -545,6 +545,7 @@ impl ElasticPlant {
             ReelState::Locked => 0.0,
             _ => command_mps,
         };
+        self.ws.resample_drag();
         if self.flight.is_some() {
             self.step_flight(command, period_s)?;
             self.t_s += period_s;
