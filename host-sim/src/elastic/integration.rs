@@ -44,13 +44,12 @@ pub(super) struct Rates {
 
 impl State {
     /// `self` = a stage of the RK4 step from `y`, `tau` into it: the velocities and the
-    /// first-order quantities advanced by `tau`·`k`; the positions by `tau`·(`y`'s velocities)
-    /// plus `c`·(the accelerations `a`) for `curve` = Some((c, a)). With the stages' rates
-    /// k_1…k_4, RK4 for ρ̇ = v, v̇ = a(ρ, v) is ρ_2 = ρ + (h/2)v, ρ_3 = ρ + (h/2)v + (h²/4)a_1,
-    /// ρ_4 = ρ + hv + (h²/2)a_2, v_j = v + c_j h a_(j−1).
-    fn set_stage(&mut self, y: &State, tau: f64, k: &Rates, curve: Option<(f64, &Rates)>) {
-        let (c, a_ref) = curve.map_or((0.0, Vec3::zeros()), |(c, a)| (c, a.accel_ref));
-        self.r_ref = y.r_ref + y.v_ref * tau + a_ref * c;
+    /// first-order quantities advanced by `tau`·`k`, the positions by `tau`·(`y`'s velocities)
+    /// plus `c`·(the accelerations `a`). With the stages' rates k_1…k_4, RK4 for ρ̇ = v,
+    /// v̇ = a(ρ, v) is ρ_2 = ρ + (h/2)v, ρ_3 = ρ + (h/2)v + (h²/4)a_1, ρ_4 = ρ + hv + (h²/2)a_2,
+    /// v_j = v + c_j h a_(j−1).
+    fn set_stage(&mut self, y: &State, tau: f64, k: &Rates, c: f64, a: &Rates) {
+        self.r_ref = y.r_ref + y.v_ref * tau + a.accel_ref * c;
         self.v_ref = y.v_ref + k.accel_ref * tau;
         self.paid_out_m = y.paid_out_m + k.paid_out_mps * tau;
         self.drum_speed_radps = y.drum_speed_radps + k.drum_accel_radps2 * tau;
@@ -58,25 +57,16 @@ impl State {
         let n = y.pos.len();
         self.pos.resize(n, Vec3::zeros());
         self.vel.resize(n, Vec3::zeros());
+        let (pos, vel) = (&mut self.pos[..n], &mut self.vel[..n]);
+        let (y_pos, y_vel, k, a) = (&y.pos[..n], &y.vel[..n], &k.accel[..n], &a.accel[..n]);
         for i in 0..n {
-            self.vel[i] = y.vel[i] + k.accel[i] * tau;
-        }
-        match curve {
-            None => {
-                for i in 0..n {
-                    self.pos[i] = y.pos[i] + y.vel[i] * tau;
-                }
-            }
-            Some((c, a)) => {
-                for i in 0..n {
-                    self.pos[i] = y.pos[i] + y.vel[i] * tau + a.accel[i] * c;
-                }
-            }
+            pos[i] = y_pos[i] + y_vel[i] * tau + a[i] * c;
+            vel[i] = y_vel[i] + k[i] * tau;
         }
     }
 
     pub(super) fn is_finite(&self) -> bool {
-        let v = |x: &Vec3| x.iter().all(|c| c.is_finite());
+        let v = |x: &Vec3| x.x.is_finite() && x.y.is_finite() && x.z.is_finite();
         v(&self.r_ref)
             && v(&self.v_ref)
             && self.paid_out_m.is_finite()
@@ -351,11 +341,11 @@ pub(super) fn rk4_step(
     let [k1, k2, k3, k4] = &mut ws.k;
     let (masses, drag, stage) = (&mut ws.masses, &mut ws.drag, &mut ws.stage);
     derivative(p, layout, y, drives[0], masses, drag, k1);
-    stage.set_stage(y, 0.5 * h, k1, None);
+    stage.set_stage(y, 0.5 * h, k1, 0.0, k1);
     derivative(p, layout, stage, drives[1], masses, drag, k2);
-    stage.set_stage(y, 0.5 * h, k2, Some((0.25 * h * h, k1)));
+    stage.set_stage(y, 0.5 * h, k2, 0.25 * h * h, k1);
     derivative(p, layout, stage, drives[1], masses, drag, k3);
-    stage.set_stage(y, h, k3, Some((0.5 * h * h, k2)));
+    stage.set_stage(y, h, k3, 0.5 * h * h, k2);
     derivative(p, layout, stage, drives[2], masses, drag, k4);
     // ρ ← ρ + hv + (h²/6)(a_1 + a_2 + a_3), v ← v + (h/6)(a_1 + 2a_2 + 2a_3 + a_4).
     let c = h / 6.0;

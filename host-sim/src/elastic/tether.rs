@@ -143,17 +143,16 @@ impl Layout {
         let rho = tether.density_kg_per_m;
         let ls = tether.segment_length_m;
         let lr = self.reel_segment_m(tether, paid_out_m);
+        let n = self.nodes();
         masses.clear();
-        masses.push(main_initial_kg - rho * paid_out_m + 0.5 * rho * lr);
+        masses.resize(n, rho * ls);
+        masses[0] = main_initial_kg - rho * paid_out_m + 0.5 * rho * lr;
         if self.beads == 0 {
-            masses.push(sub_kg + 0.5 * rho * lr);
-            return;
+            masses[1] = sub_kg + 0.5 * rho * lr;
+        } else {
+            masses[1] = 0.5 * rho * (lr + ls);
+            masses[n - 1] = sub_kg + 0.5 * rho * ls;
         }
-        masses.push(0.5 * rho * (lr + ls));
-        for _ in 1..self.beads {
-            masses.push(rho * ls);
-        }
-        masses.push(sub_kg + 0.5 * rho * ls);
     }
 }
 
