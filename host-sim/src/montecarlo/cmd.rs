@@ -434,7 +434,7 @@ pub fn montecarlo(args: &MonteCarloArgs) -> anyhow::Result<()> {
 /// The processor time of this process so far, user and system, in seconds: fields 14 and 15
 /// of `/proc/self/stat` (Linux; in clock ticks of `USER_HZ`, 100 on every Linux platform);
 /// `None` elsewhere.
-fn process_cpu_seconds() -> Option<f64> {
+pub fn process_cpu_seconds() -> Option<f64> {
     const USER_HZ: f64 = 100.0;
     let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
     // The program's name, field 2, is in parentheses and may hold spaces: count after it.
