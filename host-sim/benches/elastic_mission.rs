@@ -17,8 +17,8 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 use std::path::Path;
 use std::time::Duration;
-use tss_sim::montecarlo::cmd::process_cpu_seconds;
 use tss_sim::elastic::{ElasticParams, ElasticPlant, InitialConditions};
+use tss_sim::montecarlo::cmd::process_cpu_seconds;
 use tss_sim::scenario::Scenario;
 
 fn bench(c: &mut Criterion) {

@@ -747,21 +747,20 @@ fn refining_the_beads_converges_the_30_km_keeps_range() {
     assert!(change(0) < 10.0, "{}", change(0));
 }
 
-/// Convergence in the step (long: three 20-h missions, a few seconds each in release; `cargo
-/// test --release -p tss-sim --test truth_model -- --ignored`): paper-elastic at its default
-/// `plant.courant = 2`, at 1, and at a quarter of the default step (0.5, the reference).
+/// Convergence in the step (long: three 20-h missions, under a second of CPU each in release;
+/// `cargo test --release -p tss-sim --test truth_model -- --ignored`): paper-elastic at its
+/// default `plant.courant = 2`, at 1, and at a quarter of the default step (0.5, the reference).
 ///
-/// What the default guarantees: up to the tether's first slack episode (18 540 s, in the 30-km
-/// keep) the histories converge pointwise at RK4's order: l_u within 3 m and the tension at
-/// the reel within 1.5 N of the reference at courant 2 (the fastest, numerically damped modes
-/// are the beads' 7.3 rad/s, ωh = 1.8), ten times closer at courant 1 (the error falls by
-/// 2⁴ per halving). From the first slack–snap on, the histories part (a free flight ended by a
-/// snap is sensitive to its start: 200–1 100 m apart at any two steps, as between two runs
-/// differing in the 12th digit): only statistics are converged quantities, and the share of
-/// samples slack agrees within 2 points.
+/// What the default guarantees: the tether stays taut in all three (the tension loop), and the
+/// histories agree pointwise over the whole mission: l_u within 6 m and the tension at the reel
+/// within 0.2 N of the reference at courant 2 (measured 4.5 m and 0.12 N, during the deployment
+/// near 10 km and the retrieval's start), l_u several times closer at courant 1 (0.6 m). The
+/// tension's 0.12 N is the same at courant 1: the chain's highest modes (the beads' 7.3 rad/s
+/// and above), which RK4 damps at ωh ≥ 1 and resolves at the reference's ωh ≤ 0.5, ring
+/// there at 0.1 N.
 #[test]
 #[ignore = "three 20-hour missions"]
-fn the_default_step_converges_up_to_the_first_slack() {
+fn the_default_step_converges() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper-elastic.toml");
     let fly = |courant: f64| {
         let sets = [format!("plant.courant={courant}")];
@@ -771,43 +770,31 @@ fn the_default_step_converges_up_to_the_first_slack() {
     let default = Scenario::load(&path, &[]).unwrap().plant.courant;
     assert_eq!(default, 2.0);
     let reference = fly(default / 4.0);
-    let first_slack = reference
-        .samples
-        .iter()
-        .find(|s| s.t_s > 0.0 && s.tension_n <= 0.0)
-        .unwrap()
-        .t_s;
-    let slack_share = |h: &tss_sim::history::History| {
-        h.samples.iter().filter(|s| s.tension_n <= 0.0).count() as f64 / h.samples.len() as f64
-    };
+    let taut = |h: &tss_sim::history::History| h.samples.iter().all(|s| s.tension_n > 0.0);
+    assert!(taut(&reference));
     let mut errors = Vec::new();
     for courant in [default, default / 2.0] {
         let h = fly(courant);
-        let before = h
-            .samples
-            .iter()
-            .zip(&reference.samples)
-            .filter(|(s, _)| s.t_s < first_slack);
-        let (dl, dt) = before.fold((0.0_f64, 0.0_f64), |(dl, dt), (a, b)| {
-            (
-                dl.max((a.length_m - b.length_m).abs()),
-                dt.max((a.tension_n - b.tension_n).abs()),
-            )
-        });
-        let share = (slack_share(&h) - slack_share(&reference)).abs();
-        println!(
-            "courant {courant} vs {}: before the first slack ({first_slack} s) |Δl_u| ≤ {dl:.3} m, \
-             |ΔT| ≤ {dt:.3} N; slack share {:.3} vs {:.3}",
-            default / 4.0,
-            slack_share(&h),
-            slack_share(&reference)
+        assert!(taut(&h), "slack at courant {courant}");
+        assert_eq!(h.samples.len(), reference.samples.len());
+        let (dl, dt) = h.samples.iter().zip(&reference.samples).fold(
+            (0.0_f64, 0.0_f64),
+            |(dl, dt), (a, b)| {
+                (
+                    dl.max((a.length_m - b.length_m).abs()),
+                    dt.max((a.tension_n - b.tension_n).abs()),
+                )
+            },
         );
-        assert!(share < 0.02, "{share}");
+        println!(
+            "courant {courant} vs {}: over the mission |Δl_u| ≤ {dl:.3} m, |ΔT| ≤ {dt:.3} N",
+            default / 4.0
+        );
         errors.push((dl, dt));
     }
-    assert!(errors[0].0 < 3.0 && errors[0].1 < 1.5, "{:?}", errors[0]);
-    assert!(errors[1].0 < 0.3 && errors[1].1 < 0.15, "{:?}", errors[1]);
-    assert!(errors[1].0 * 8.0 < errors[0].0, "{errors:?}");
+    assert!(errors[0].0 < 6.0 && errors[0].1 < 0.2, "{:?}", errors[0]);
+    assert!(errors[1].0 < 1.0 && errors[1].1 < 0.2, "{:?}", errors[1]);
+    assert!(errors[1].0 * 4.0 < errors[0].0, "{errors:?}");
 }
 
 /// The orbit's node, rad, from the centre of mass's angular momentum h: Ω = atan2(h_x, −h_y).
