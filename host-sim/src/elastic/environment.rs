@@ -175,56 +175,13 @@ const BANDS: [Band; 28] = [
 /// equatorial sphere, kg/m³. Below 0 m the sea-level band is used; above 1000 km the last
 /// band continues.
 pub fn atmosphere_density_kgpm3(altitude_m: f64) -> f64 {
-    AirSample::at(altitude_m).density_kgpm3
-}
-
-/// The largest |h − h_s|/H that [`AirSample::density_kgpm3_at`] takes from its series (its
-/// sixth-order term is then below 2e-15 of the density); beyond, it calls `exp`.
-const SERIES_LIMIT: f64 = 1e-2;
-
-/// The exponential atmosphere sampled at one altitude: its density there and its band's scale
-/// height, from which the density nearby follows without another `exp`.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct AirSample {
-    /// Altitude of the sample, m.
-    pub altitude_m: f64,
-    /// Density there, kg/m³.
-    pub density_kgpm3: f64,
-    /// 1/H of its band, 1/m.
-    pub inverse_scale_height_per_m: f64,
-}
-
-impl AirSample {
-    /// The atmosphere (Vallado Table 8-4) at `altitude_m`.
-    pub fn at(altitude_m: f64) -> Self {
-        let h_km = altitude_m / 1000.0;
-        let band = BANDS
-            .iter()
-            .rev()
-            .find(|b| h_km >= b.base_km)
-            .unwrap_or(&BANDS[0]);
-        Self {
-            altitude_m,
-            density_kgpm3: band.density_kgpm3
-                * (-(h_km - band.base_km) / band.scale_height_km).exp(),
-            inverse_scale_height_per_m: 1.0 / (band.scale_height_km * 1000.0),
-        }
-    }
-
-    /// The density at `altitude_m` in the sample's band, kg/m³: ρ_s exp(−(h − h_s)/H), the
-    /// exponential by its Taylor series to fifth order while |h − h_s|/H ≤ 1e-2 (an integration
-    /// substep moves a node by far less than 1 % of a scale height, ≥ 5.4 km), exact to 2e-15.
-    /// Near a band's edge this continues the sample's band (the table is discontinuous there
-    /// by up to 3 %).
-    #[inline]
-    pub fn density_kgpm3_at(&self, altitude_m: f64) -> f64 {
-        let u = (self.altitude_m - altitude_m) * self.inverse_scale_height_per_m;
-        if u.abs() > SERIES_LIMIT {
-            return self.density_kgpm3 * u.exp();
-        }
-        let series = 1.0 + u * (1.0 + u * (0.5 + u * (1.0 / 6.0 + u * (1.0 / 24.0 + u / 120.0))));
-        self.density_kgpm3 * series
-    }
+    let h_km = altitude_m / 1000.0;
+    let band = BANDS
+        .iter()
+        .rev()
+        .find(|b| h_km >= b.base_km)
+        .unwrap_or(&BANDS[0]);
+    band.density_kgpm3 * (-(h_km - band.base_km) / band.scale_height_km).exp()
 }
 
 #[cfg(test)]
@@ -245,22 +202,6 @@ mod tests {
                 w[1].base_km,
                 w[1].density_kgpm3
             );
-        }
-    }
-
-    #[test]
-    fn a_sample_continues_its_band_exactly() {
-        for h in [300e3, 699e3, 700e3, 850e3, 20e3] {
-            let sample = AirSample::at(h);
-            for dh in [-500.0, -3.0, 0.0, 1e-3, 7.0, 500.0] {
-                let exact = sample.density_kgpm3 * (-dh * sample.inverse_scale_height_per_m).exp();
-                let got = sample.density_kgpm3_at(h + dh);
-                assert!(
-                    (got - exact).abs() <= 4e-15 * exact,
-                    "{h} {dh}: {got} vs {exact}"
-                );
-            }
-            assert_eq!(sample.density_kgpm3, atmosphere_density_kgpm3(h));
         }
     }
 
