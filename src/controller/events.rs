@@ -40,6 +40,9 @@ pub enum EventKind {
     /// The tension loop's mode changed (docs/equations.md §17.6): its load cell came, coasted,
     /// was lost or came back.
     TensionLoop(super::TensionLoopMode),
+    /// A mode command was applied at this period boundary
+    /// ([`Controller::command`](super::Controller::command)).
+    Command(super::ModeCommand),
 }
 
 /// An event and the tick it happened at.

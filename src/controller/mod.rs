@@ -80,6 +80,7 @@
 //! `recovery_ticks` samples in a row are back inside.
 
 mod clock;
+mod command;
 mod drive;
 mod estimation;
 mod events;
@@ -103,6 +104,7 @@ pub use crate::config::{
 };
 pub use crate::envelope::Envelope;
 pub use crate::monitor::{Input, Sensor};
+pub use command::{Mode, ModeCommand, Refusal};
 pub use events::{Event, EventKind, EVENT_CAPACITY};
 pub use output::{Fault, Flags, Health, Output, Phase};
 pub use protection::MARGIN_OF_GRAVITY_GRADIENT;
@@ -400,6 +402,18 @@ impl<T: Real> Controller<T> {
         self.sequencer.request_stage2();
     }
 
+    /// A mission-mode command (docs/equations.md §7.1): taken if it is legal in the current
+    /// mode and phase and no other command waits, and applied at the next period boundary
+    /// (then [`EventKind::Command`]); refused, it changes nothing.
+    pub fn command(&mut self, command: ModeCommand) -> Result<(), Refusal> {
+        self.sequencer.command(command)
+    }
+
+    /// The mode: flying, or held by command ([`Flags::HELD`], [`Flags::ABORTED`]).
+    pub fn mode(&self) -> Mode {
+        self.sequencer.mode()
+    }
+
     /// One control period with a fresh sensor sample: the command for the coming period and
     /// what it was made of, the output the controller keeps ([`Controller::output`]).
     pub fn step(&mut self, input: &Input<T>) -> &Output<T> {
@@ -438,6 +452,11 @@ impl<T: Real> Controller<T> {
                 return self.hold(tick, true, alpha_ref_rad, None)
             }
         };
+        if self.sequencer.mode().holds() {
+            // A usable sample the commanded hold does not fly the law on.
+            self.health.usable();
+            return self.hold(tick, true, reference.angle.angle_rad, None);
+        }
         let solved = match self.law(tick, &sensed, &reference) {
             Ok(solved) => solved,
             Err(unusable) => return self.reject(tick, unusable),
@@ -449,7 +468,7 @@ impl<T: Real> Controller<T> {
 
     /// The start of a period in which time moved to `tick`: the mission's stages begin when
     /// due (stage 1 with the first step, stage 2 at its tick or on command, restarting the
-    /// blend), the protection's drive model runs over the periods that passed, and the length
+    /// blend), a mode command that waits is applied, the protection's drive model runs over the periods that passed, and the length
     /// is dead-reckoned at the last command.
     fn begin_period(
         &mut self,
@@ -476,6 +495,10 @@ impl<T: Real> Controller<T> {
         }
         let elapsed_s = T::from_u32(elapsed_ticks) * self.cfg.period_s;
         let predicted_m = self.length.predict(last.rate_mps, elapsed_s);
+        let applied = self
+            .sequencer
+            .apply_pending(&self.cfg, tick, last.rate_mps);
+        self.events.record(tick, applied.map(EventKind::Command));
         self.sequencer.begin_stage2_if_due(tick, last.rate_mps);
         Period {
             tick,
@@ -772,8 +795,9 @@ impl<T: Real> Controller<T> {
     }
 
     /// The safe actions at `now` (`time_moved`: to `now`; otherwise `now` is the last accepted
-    /// tick). Degraded: keep the last command (coast). Safe hold: ramp the rate to zero at
-    /// `monitor.safe_hold_decel_mps2` (at most the envelope's limit). When time did not move,
+    /// tick). Degraded: keep the last command (coast). Safe hold, and a hold by command in any
+    /// health: ramp the rate to zero at `monitor.safe_hold_decel_mps2` (at most the envelope's
+    /// limit). When time did not move,
     /// the command stays. All stay inside the length limits, judged on the estimated length
     /// (before any accepted sample, on the docking end: 0 m).
     fn hold(
@@ -788,9 +812,10 @@ impl<T: Real> Controller<T> {
         if let Some(t) = &mut self.tension {
             t.skipped();
         }
-        let target = match (time_moved, self.health.health()) {
-            (false, _) | (true, Health::Degraded) => previous,
-            (true, Health::Nominal | Health::SafeHold) => {
+        let mode = self.sequencer.mode();
+        let target = match (time_moved, self.health.health(), mode.holds()) {
+            (false, _, _) | (true, Health::Degraded, false) => previous,
+            (true, Health::Nominal | Health::SafeHold, _) | (true, Health::Degraded, true) => {
                 let step = self.safe_hold_step_mps;
                 previous - previous.clamp_finite(-step, step)
             }
@@ -802,6 +827,8 @@ impl<T: Real> Controller<T> {
             .limit_request(target, previous, length_m, dt, &bounds);
         let mut flags = Flags(sat.0 & (Flags::LENGTH_LIMITED | Flags::TENSION_LIMITED));
         flags.set(Flags::SAFE_ACTION);
+        flags.set_if(matches!(mode, Mode::Held { .. }), Flags::HELD);
+        flags.set_if(mode == Mode::Aborted, Flags::ABORTED);
         let mu3 = self.cfg.masses.mu3_and_slope(length_m).0;
         Decided {
             command: Command {

@@ -102,6 +102,11 @@ impl Flags {
     pub const TENSION_SHAPED: u32 = 1 << 11;
     /// The tension loop flies without its load cell: it was lost (docs/equations.md §17.6).
     pub const LOAD_CELL_LOST: u32 = 1 << 12;
+    /// The reel is held by command ([`super::Mode::Held`]; with [`Flags::SAFE_ACTION`]).
+    pub const HELD: u32 = 1 << 13;
+    /// The mission is aborted to a safe hold ([`super::Mode::Aborted`]; with
+    /// [`Flags::SAFE_ACTION`]).
+    pub const ABORTED: u32 = 1 << 14;
 
     /// `true` if every bit of `mask` is set.
     pub fn contains(self, mask: u32) -> bool {

@@ -22,6 +22,7 @@ use crate::law::Blend;
 use crate::real::Real;
 use crate::schedule::{LibratingReference, PreparedBand, Reference};
 
+use super::command::{transition, Effect, Mode, ModeCommand, Refusal};
 use super::output::Phase;
 
 /// The progress window, in time constants of the stage's loop (see the module docs): long
@@ -182,6 +183,10 @@ pub(super) struct Sequencer<T> {
     progress_window_ticks: [u32; 2],
     /// The progress a window must make, m.
     min_progress_m: T,
+    /// Flying, or held by command.
+    mode: Mode,
+    /// A command accepted and waiting for the next period boundary.
+    pending: Option<ModeCommand>,
 }
 
 impl<T: Real> Sequencer<T> {
@@ -226,7 +231,63 @@ impl<T: Real> Sequencer<T> {
             approach: None,
             progress_window_ticks: decay_rate_per_s.map(window),
             min_progress_m: cfg.keep_capture_m,
+            mode: Mode::Flying,
+            pending: None,
         }
+    }
+
+    /// The mode (flying, or held by command).
+    pub(super) fn mode(&self) -> Mode {
+        self.mode
+    }
+
+    /// Takes `command` for the next period boundary if it is legal in the current mode and
+    /// phase ([`transition`]) and no other command waits; a refused one changes nothing.
+    pub(super) fn command(&mut self, command: ModeCommand) -> Result<(), Refusal> {
+        if self.pending.is_some() {
+            return Err(Refusal::Pending);
+        }
+        transition(self.mode, self.phase, command, 0)?;
+        self.pending = Some(command);
+        Ok(())
+    }
+
+    /// At the period boundary `tick` (time moved to it), the reel at `rate_mps`: applies the
+    /// command that waits, if any, and returns it. A hold ends with its effect on the
+    /// mission's clock: the stage-2 start and the slew are moved on by the ticks it lasted, so
+    /// the phase held goes on as it was, its blend restarted from the current rate. A new
+    /// deployment is stage 1 afresh from now, from the current rate (`cfg`: the configuration
+    /// the sequencer was made from).
+    pub(super) fn apply_pending(
+        &mut self,
+        cfg: &Config<T>,
+        tick: u32,
+        rate_mps: T,
+    ) -> Option<ModeCommand> {
+        let command = self.pending.take()?;
+        // Judged when it was given, against the mode and phase it meets here (nothing changes
+        // them between two steps): not refused now.
+        let (mode, effect) = transition(self.mode, self.phase, command, tick).ok()?;
+        match effect {
+            Effect::None => {}
+            Effect::Resume { held_since_tick } => {
+                let held_ticks = tick.wrapping_sub(held_since_tick);
+                self.mission_start_tick = self.mission_start_tick.wrapping_add(held_ticks);
+                self.stage_start_tick = self.stage_start_tick.wrapping_add(held_ticks);
+                self.restart_blend(tick, rate_mps);
+            }
+            Effect::BeginStage2 => self.request_stage2(),
+            Effect::NewDeployment => {
+                let restarts = self.blend_restarts;
+                *self = Self::new(cfg);
+                self.blend_restarts = restarts;
+                self.mission_start_tick = tick;
+                self.stage_start_tick = tick;
+                self.restart_blend(tick, rate_mps);
+            }
+        }
+        self.mode = mode;
+        Some(command)
     }
 
     /// The current phase.
@@ -258,7 +319,12 @@ impl<T: Real> Sequencer<T> {
 
     /// Begins stage 2 if it is due at `tick` (at its tick or on request): α_r slews, and the
     /// blend restarts from the current rate `rate_mps`.
+    /// Not while the reel is held by command (the mission's clock stops; see
+    /// [`Sequencer::apply_pending`]).
     pub(super) fn begin_stage2_if_due(&mut self, tick: u32, rate_mps: T) {
+        if self.mode.holds() {
+            return;
+        }
         let due = match self.stage2 {
             // Mission time: ticks since the first step (modulo 2³², as every tick difference).
             Stage2Start::At(start) => tick.wrapping_sub(self.mission_start_tick) >= start,

@@ -29,6 +29,7 @@ use spacepackets::ecss::tm::{PusTmCreator, PusTmSecondaryHeader};
 use spacepackets::ecss::{CreatorConfig, MessageTypeId, PusPacket, PusVersion};
 use spacepackets::{CcsdsPacket, PacketType, SpHeader};
 
+pub use crate::controller::ModeCommand;
 use crate::link::{ParamTable, PARAM_WORDS};
 
 /// The reel unit's application process identifier (its telecommands and its telemetry).
@@ -47,37 +48,6 @@ pub const MAX_TC_LEN: usize = TC_OVERHEAD_LEN + TABLE_LOAD_LEN;
 /// CRC-32/ISO-HDLC of the parameter table's words (as in the PIL link's frames).
 const TABLE_CRC: crc::Crc<u32, crc::NoTable> =
     crc::Crc::<u32, crc::NoTable>::new(&crc::CRC_32_ISO_HDLC);
-
-/// The mission modes the on-board computer commands (TC\[8,1\] function identifiers).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum ModeCommand {
-    /// Release the sub-satellite and start the deployment (stage 1).
-    StartDeployment = 1,
-    /// Stop the reel and hold the length (a commanded safe hold).
-    Hold = 2,
-    /// Leave a commanded hold and go on with the phase that was held.
-    Resume = 3,
-    /// Start the retrieval (stage 2) now.
-    Retrieve = 4,
-    /// Abort: ramp the reel to rest and hold for good (until a new deployment is loaded).
-    Abort = 5,
-}
-
-impl ModeCommand {
-    /// The command of a function identifier (`None` for an unknown one).
-    pub fn from_id(id: u16) -> Option<Self> {
-        [
-            Self::StartDeployment,
-            Self::Hold,
-            Self::Resume,
-            Self::Retrieve,
-            Self::Abort,
-        ]
-        .into_iter()
-        .find(|&m| m as u16 == id)
-    }
-}
 
 /// What a valid telecommand asks.
 // The table is held inline: there is no heap to box it on, and one request is held at a time.
