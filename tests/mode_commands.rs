@@ -92,7 +92,10 @@ fn a_hold_brings_the_reel_to_rest_within_the_envelope_and_keeps_the_length() {
     let mut rest_tick = None;
     for _ in 0..2_000 {
         let out = f.step();
-        assert!(out.flags.contains(Flags::HELD | Flags::SAFE_ACTION), "{out:?}");
+        assert!(
+            out.flags.contains(Flags::HELD | Flags::SAFE_ACTION),
+            "{out:?}"
+        );
         assert!((out.rate_cmd_mps - prev).abs() <= a * 1.000_01, "{out:?}");
         assert!(out.rate_cmd_mps.abs() <= prev.abs());
         prev = out.rate_cmd_mps;
@@ -138,7 +141,10 @@ fn resume_goes_on_with_the_phase_held_and_its_clock() {
     );
     let out = f.step();
     assert_eq!(out.tick, 3_000);
-    assert!(matches!(out.phase, Phase::Slew | Phase::Retrieve), "{out:?}");
+    assert!(
+        matches!(out.phase, Phase::Slew | Phase::Retrieve),
+        "{out:?}"
+    );
 }
 
 #[test]
@@ -151,7 +157,10 @@ fn retrieve_begins_stage_2_from_stage_1_only() {
     f.ctl.command(ModeCommand::Retrieve).unwrap();
     // (At 110 m the slew meets Eq. 35 at once: retrieval.)
     let out = f.step();
-    assert!(matches!(out.phase, Phase::Slew | Phase::Retrieve), "{out:?}");
+    assert!(
+        matches!(out.phase, Phase::Slew | Phase::Retrieve),
+        "{out:?}"
+    );
     assert_eq!(f.ctl.mode(), Mode::Flying);
     assert_eq!(
         f.ctl.command(ModeCommand::Retrieve),
@@ -177,7 +186,9 @@ fn an_abort_holds_for_good_until_a_new_deployment() {
     f.ctl.command(ModeCommand::StartDeployment).unwrap();
     let out = f.step();
     assert_eq!((out.phase, f.ctl.mode()), (Phase::Deploy, Mode::Flying));
-    assert!(out.flags.contains(Flags::BLEND_RESTART | Flags::PHASE_CHANGED));
+    assert!(out
+        .flags
+        .contains(Flags::BLEND_RESTART | Flags::PHASE_CHANGED));
     // The new mission's clock: stage 2 again 300 s after the new start.
     let start = out.tick;
     f.fly(299);
@@ -205,7 +216,10 @@ fn one_command_at_a_time_and_each_refusal_names_its_rule() {
         f.ctl.command(ModeCommand::Abort),
         Err(Refusal::AlreadyAborted)
     );
-    assert_eq!(f.ctl.command(ModeCommand::Retrieve), Err(Refusal::NotInStage1));
+    assert_eq!(
+        f.ctl.command(ModeCommand::Retrieve),
+        Err(Refusal::NotInStage1)
+    );
 }
 
 /// What the proptest does each period.

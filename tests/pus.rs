@@ -132,3 +132,259 @@ fn decoder_throughput() {
     );
     assert_eq!(accepted + rejected, u64::from(n));
 }
+
+// ---- The unit: every telecommand verified, a bad one changes nothing ----
+
+use tss_reel::controller::{Config, Controller, Flags, Input, Mode};
+use tss_reel::pus::{read_telemetry, Housekeeping, Services, Stage, Telemetry, MAX_TCS_PER_PERIOD};
+
+const N_RADPS: f32 = 1.060_237_2e-3;
+
+fn sample(tick: u32, length_m: f32) -> Input<f32> {
+    Input {
+        tick,
+        length_m,
+        reel_rate_mps: None,
+        tension_n: Some(3.0),
+        alpha_rad: Some(-0.6),
+        alpha_rate_radps: Some(0.0),
+        orbit_rate_radps: N_RADPS,
+        true_anomaly_rad: 0.0,
+    }
+}
+
+/// The paper's controller after `ticks` periods on a kinematic reel, its services, and the
+/// length it reached.
+fn flown(ticks: u32) -> (Controller<f32>, Services, f32) {
+    let mut ctl = Controller::new(Config::paper()).unwrap();
+    let mut services = Services::new();
+    let mut l = 1.0;
+    for tick in 0..ticks {
+        let x = sample(tick, l);
+        let rate = ctl.step(&x).rate_cmd_mps;
+        services.after_step(&mut ctl, Some(&x), &mut |_| {});
+        l += rate;
+    }
+    (ctl, services, l)
+}
+
+/// The periods flown before the fuzzed telecommand arrives: none (a table may still be
+/// loaded), one, and 200 (paying out).
+const FLOWN_TICKS: [u32; 3] = [0, 1, 200];
+
+/// [`flown`] at one of [`FLOWN_TICKS`], flown once per test binary.
+fn in_flight(ticks: u32) -> &'static (Controller<f32>, Services, f32) {
+    static FLOWN: std::sync::OnceLock<Vec<(Controller<f32>, Services, f32)>> =
+        std::sync::OnceLock::new();
+    let all = FLOWN.get_or_init(|| FLOWN_TICKS.map(flown).into_iter().collect());
+    &all[FLOWN_TICKS.iter().position(|&t| t == ticks).unwrap()]
+}
+
+/// The unit's answer to one telecommand `bytes`: its telemetry, read back.
+fn answer(services: &mut Services, ctl: &mut Controller<f32>, bytes: &[u8]) -> Vec<Telemetry> {
+    let mut sent = Vec::new();
+    services.telecommand(bytes, ctl, &mut |p| sent.push(p.to_vec()));
+    sent.iter()
+        .map(|p| {
+            read_telemetry(p)
+                .expect("the unit's own packets read back")
+                .telemetry
+        })
+        .collect()
+}
+
+/// The verification reports in `tm`: (stage, failure code).
+fn verification(tm: &[Telemetry]) -> Vec<(Stage, Option<u16>)> {
+    tm.iter()
+        .filter_map(|t| match t {
+            Telemetry::Verification { stage, failure, .. } => Some((*stage, failure.map(|f| f.0))),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Arbitrary bytes, a valid telecommand with one byte changed, or a valid telecommand.
+fn any_packet() -> impl Strategy<Value = Vec<u8>> {
+    prop_oneof![
+        proptest::collection::vec(any::<u8>(), 0..=MAX_TC_LEN + 16),
+        (
+            telecommand(),
+            0u16..0x4000,
+            any::<prop::sample::Index>(),
+            1u8..=255
+        )
+            .prop_map(|(c, seq, at, flip)| {
+                let mut b = packet(&c, seq);
+                let i = at.index(b.len());
+                b[i] ^= flip;
+                b
+            }),
+        (telecommand(), 0u16..0x4000).prop_map(|(c, seq)| packet(&c, seq)),
+    ]
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    /// Any packet to a unit in flight: every one with an identity (four bytes) is answered by
+    /// service 1 reports naming it, acceptance first; a failure at any stage leaves the
+    /// controller as it was (its next step is the one it would have made without the packet).
+    #[test]
+    fn every_telecommand_is_verified_and_a_failed_one_changes_nothing(
+        bytes in any_packet(),
+        at_tick in prop::sample::select(FLOWN_TICKS.to_vec()),
+    ) {
+        let (ctl0, services0, l) = in_flight(at_tick);
+        let (mut ctl, mut services) = (ctl0.clone(), services0.clone());
+        let tm = answer(&mut services, &mut ctl, &bytes);
+        let reports = verification(&tm);
+        match RequestId::of(&bytes) {
+            None => prop_assert!(reports.is_empty()),
+            Some(id) => {
+                prop_assert!(!reports.is_empty());
+                prop_assert_eq!(reports[0].0, Stage::Acceptance);
+                for t in &tm {
+                    if let Telemetry::Verification { request, .. } = t {
+                        prop_assert_eq!(*request, id);
+                    }
+                }
+            }
+        }
+        if reports.iter().any(|(_, f)| f.is_some()) {
+            let x = sample(at_tick, *l);
+            let mut twin = ctl0.clone();
+            prop_assert_eq!(ctl.mode(), twin.mode());
+            prop_assert_eq!(*ctl.step(&x), *twin.step(&x));
+        }
+    }
+}
+
+#[test]
+fn a_mode_command_completes_at_its_boundary_and_the_rest_is_reported() {
+    let (mut ctl, mut services, l) = flown(100);
+    // An illegal mode: accepted, then refused at its start (code 14: not held).
+    let tm = answer(
+        &mut services,
+        &mut ctl,
+        &packet(&Telecommand::Mode(ModeCommand::Resume), 1),
+    );
+    assert_eq!(
+        verification(&tm),
+        [(Stage::Acceptance, None), (Stage::Start, Some(14))]
+    );
+    // Hold: accepted and started now, completed after the step that applied it.
+    let tm = answer(
+        &mut services,
+        &mut ctl,
+        &packet(&Telecommand::Mode(ModeCommand::Hold), 2),
+    );
+    assert_eq!(
+        verification(&tm),
+        [(Stage::Acceptance, None), (Stage::Start, None)]
+    );
+    let x = sample(100, l);
+    ctl.step(&x);
+    let mut sent = Vec::new();
+    services.after_step(&mut ctl, Some(&x), &mut |p| sent.push(p.to_vec()));
+    let tm: Vec<Telemetry> = sent
+        .iter()
+        .map(|p| read_telemetry(p).unwrap().telemetry)
+        .collect();
+    assert_eq!(verification(&tm), [(Stage::Completion, None)]);
+    assert!(tm.iter().any(|t| matches!(
+        t,
+        Telemetry::Event {
+            id: 10,
+            aux: [2, 0, 0, 0],
+            ..
+        }
+    )));
+    let Some(Telemetry::Housekeeping(hk)) = tm.last() else {
+        panic!("housekeeping last: {tm:?}");
+    };
+    assert_eq!(*hk, Housekeeping::of(&ctl, Some(&x)));
+    assert_eq!(ctl.mode(), Mode::Held { since_tick: 100 });
+    assert!(Flags(hk.flags).contains(Flags::HELD));
+    assert_eq!(
+        (hk.mode, hk.tension_n, hk.alpha_rad),
+        (1, Some(3.0), Some(-0.6))
+    );
+
+    // A table after the start: too late (21). Time: completed at once, the stamps move.
+    let table = ParamTable::from_config(&Config::paper());
+    let tm = answer(
+        &mut services,
+        &mut ctl,
+        &packet(&Telecommand::LoadParams(table), 3),
+    );
+    assert_eq!(
+        verification(&tm),
+        [(Stage::Acceptance, None), (Stage::Start, Some(21))]
+    );
+    let mut sent = Vec::new();
+    services.telecommand(
+        &packet(&Telecommand::SetTime(50_000), 4),
+        &mut ctl,
+        &mut |p| sent.push(p.to_vec()),
+    );
+    assert_eq!(sent.len(), 3);
+    let x = sample(101, l);
+    ctl.step(&x);
+    let mut stamps = Vec::new();
+    services.after_step(&mut ctl, Some(&x), &mut |p| {
+        stamps.push(read_telemetry(p).unwrap().time)
+    });
+    assert_eq!(stamps, [50_000]);
+
+    // A flood: the fifth telecommand of a period is refused unread (18).
+    let codes: Vec<_> = (0..MAX_TCS_PER_PERIOD + 1)
+        .map(|k| {
+            let tm = answer(
+                &mut services,
+                &mut ctl,
+                &packet(&Telecommand::SetTime(7), u16::from(k)),
+            );
+            verification(&tm)[0]
+        })
+        .collect();
+    assert_eq!(codes.last(), Some(&(Stage::Acceptance, Some(18))));
+    assert!(codes[..MAX_TCS_PER_PERIOD as usize]
+        .iter()
+        .all(|c| c.1.is_none()));
+}
+
+#[test]
+fn a_table_is_loaded_before_the_mission_or_refused_with_its_rule() {
+    let mut ctl = Controller::new(Config::paper()).unwrap();
+    let mut services = Services::new();
+    let mut bad = Config::flight();
+    bad.gains.k1_per_s = -1.0;
+    let tm = answer(
+        &mut services,
+        &mut ctl,
+        &packet(&Telecommand::LoadParams(ParamTable::from_config(&bad)), 1),
+    );
+    let Some(Telemetry::Verification {
+        failure: Some((20, [7, 2, 0, 0])),
+        ..
+    }) = tm.last()
+    else {
+        panic!("refused: word 7 (gains.k1_per_s), rule 2 (not positive): {tm:?}");
+    };
+    assert_eq!(ctl.config(), &Config::paper());
+    let flight = ParamTable::from_config(&Config::flight());
+    let tm = answer(
+        &mut services,
+        &mut ctl,
+        &packet(&Telecommand::LoadParams(flight), 2),
+    );
+    assert_eq!(
+        verification(&tm),
+        [
+            (Stage::Acceptance, None),
+            (Stage::Start, None),
+            (Stage::Completion, None)
+        ]
+    );
+    assert_eq!(ctl.config(), &Config::flight());
+}

@@ -88,6 +88,10 @@ pub struct History {
     pub shapes: Vec<(f64, Vec<[f64; 3]>)>,
     /// The tether ran off the end of its spool, and the run stopped there (`None`: it did not).
     pub spool_overrun: Option<SpoolOverrun>,
+    /// The unit's telemetry packets (CCSDS/PUS, as sent; `crate::obc`): every verification
+    /// report and event, and the housekeeping of the ticks that have a sample (empty when the
+    /// controller in the loop has no PUS services).
+    pub telemetry: Vec<Vec<u8>>,
 }
 
 /// The tether paid out beyond the spool it is wound on (`envelope.max_length_m`): a reel has
@@ -104,7 +108,7 @@ pub struct SpoolOverrun {
 
 /// The controller's flag bits (`tss_reel::controller::Flags`, the `flags` column of
 /// `history.csv`) and their names, in bit order.
-pub const FLAG_NAMES: [(u32, &str); 13] = [
+pub const FLAG_NAMES: [(u32, &str); 15] = [
     (Flags::RATE_SATURATED, "rate-saturated"),
     (Flags::ACCEL_SATURATED, "accel-saturated"),
     (Flags::LENGTH_LIMITED, "length-limited"),
@@ -118,6 +122,8 @@ pub const FLAG_NAMES: [(u32, &str); 13] = [
     (Flags::PHASE_CHANGED, "phase-changed"),
     (Flags::TENSION_SHAPED, "tension-shaped"),
     (Flags::LOAD_CELL_LOST, "load-cell-lost"),
+    (Flags::HELD, "held"),
+    (Flags::ABORTED, "aborted"),
 ];
 
 /// The names of the bits set in `flags`, joined by `|` (e.g. `slewing|no-equilibrium`;

@@ -9,6 +9,7 @@ pub mod faults;
 pub mod history;
 pub mod laws;
 pub mod montecarlo;
+pub mod obc;
 pub mod output;
 pub mod pil;
 pub mod plant;

@@ -64,6 +64,9 @@ pub struct PilArgs {
 /// The report of the PIL link.
 pub const PIL_TXT: &str = "pil.txt";
 
+/// The unit's telemetry, decoded (`crate::obc::write_telemetry_csv`).
+pub const TELEMETRY_CSV: &str = "telemetry.csv";
+
 /// The run's verdict, machine-readable (`crate::verdict::Verdict::to_json`).
 pub const VERDICT_JSON: &str = "verdict.json";
 
@@ -71,6 +74,7 @@ pub const VERDICT_JSON: &str = "verdict.json";
 pub fn output_names() -> Vec<String> {
     let mut names: Vec<String> = [
         "history.csv",
+        TELEMETRY_CSV,
         "table1.csv",
         "summary.txt",
         "faults.txt",
@@ -138,6 +142,13 @@ fn run_pil(args: &RunArgs) -> anyhow::Result<()> {
     // Checked here too, so that a scenario too long for the firmware is a usage error.
     let scenario = Scenario::load(&args.scenario, &args.set)?;
     pil::check_duration(&scenario).map_err(|e| UsageError(e.to_string()))?;
+    if !scenario.telecommand.is_empty() {
+        return Err(UsageError(
+            "--pil: the PIL link does not carry telecommands yet (run the scenario without --pil)"
+                .to_string(),
+        )
+        .into());
+    }
     if scenario.controller.law != crate::scenario::LawName::Paper {
         return Err(UsageError(format!(
             "--pil flies the flight firmware, whose law is the paper's: controller.law = {:?} \
@@ -320,6 +331,12 @@ where
             output::write_elastic_history_csv(w, &history.samples, &history.elastic)
         }
     })?);
+    if !history.telemetry.is_empty() {
+        let period_s = scenario.controller.period_s;
+        files.push(out.write(TELEMETRY_CSV, |w| {
+            crate::obc::write_telemetry_csv(w, &history.telemetry, period_s)
+        })?);
+    }
     let table = Table1Comparison::new(&history.probes);
     files.push(out.write("table1.csv", |w| table.write_csv(w))?);
     let resolved = toml::to_string_pretty(&scenario).context("serializing the scenario")?;
@@ -340,12 +357,23 @@ where
     let verdict = Verdict::of(&scenario, &history);
     files.push(out.write(VERDICT_JSON, |w| w.write_all(verdict.to_json().as_bytes()))?);
     let summary = summarize(&scenario, &history);
-    let report = format!(
+    let mut report = format!(
         "{}\n{}\n{}",
         verdict.headline(),
         summary.render(),
         table.render()
     );
+    if !history.telemetry.is_empty() {
+        let c = crate::obc::counts(&history.telemetry);
+        report.push_str(&format!(
+            "\nTelemetry (telemetry.csv): {} verification reports ({} failures), {} events, {} \
+             housekeeping reports kept (one per history row; the unit sends one every period)\n",
+            c.verified + c.failed,
+            c.failed,
+            c.events,
+            c.housekeeping
+        ));
+    }
     files.push(out.write("summary.txt", |w| w.write_all(report.as_bytes()))?);
     // The fault summary (`crate::faults`): printed after the report and written to faults.txt.
     let faults = crate::faults::render_fault_summary(&scenario, &history.faults);

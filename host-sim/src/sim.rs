@@ -8,12 +8,15 @@
 //! the [`Plant`] trait: the rigid rod of Eq. 5 (`plant::RigidPlant`, its reel ideal or
 //! lagging and saturating) or the elastic truth model (`elastic::ElasticPlant`). Every tick
 //! feeds the fault summary (`History::faults`). A tether paid out beyond its spool
-//! (`envelope.max_length_m`) ends the run at that tick (`History::spool_overrun`).
+//! (`envelope.max_length_m`) ends the run at that tick (`History::spool_overrun`). Before a
+//! tick's step the on-board computer sends the scenario's telecommands due then
+//! (`crate::obc`); after it, the unit's telemetry is kept (`History::telemetry`).
 
 use crate::elastic::{ElasticParams, ElasticPlant, InitialConditions};
 use crate::faults::{InjectionPlan, Injector, Reading, Sensed, SummaryBuilder, TickRecord, Truth};
 use crate::history::{History, PhaseLabel, Sample, SpoolOverrun};
 use crate::laws::LawStepper;
+use crate::obc::{self, Obc, Unit};
 use crate::plant::{ix, Command, Observation, Plant, RigidModel, RigidPlant, State};
 use crate::reel::{Reel, ReelDrive};
 use crate::scenario::{PlantModel, Scenario};
@@ -55,8 +58,9 @@ pub fn initial_state<T: Real>(sc: &Scenario, cfg: &Config<T>) -> State {
     ])
 }
 
-/// Runs the scenario with its `[controller] law` in the loop: the flight controller (f32) for
-/// the paper's law, a tension law of `crate::laws` otherwise.
+/// Runs the scenario with its `[controller] law` in the loop: the flight controller (f32)
+/// behind its PUS services (`crate::obc::Unit`: the scenario's telecommands reach it, its
+/// telemetry is kept) for the paper's law, a tension law of `crate::laws` otherwise.
 ///
 /// `probe_times_s` are instants (whole control periods) at which the length is recorded in
 /// [`History::probes`]; `progress` is called with the mission time every simulated minute.
@@ -67,7 +71,10 @@ pub fn run(
 ) -> Result<History, SimError> {
     match LawStepper::new(sc, sc.controller.law)? {
         Some(mut law) => run_stepper::<f32, _>(sc, &mut law, probe_times_s, progress),
-        None => run_with::<f32>(sc, probe_times_s, progress),
+        None => {
+            let ctl = Controller::new(controller_config::<f32>(sc)?).map_err(SimError::Config)?;
+            run_stepper(sc, &mut Unit::new(ctl), probe_times_s, progress)
+        }
     }
 }
 
@@ -129,6 +136,7 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
     };
     let mut last_length_m: Option<f64> = None;
     let spool_m = sc.envelope.max_length_m;
+    let mut obc = Obc::new(sc)?;
     for tick in 0..=total {
         let t_s = f64::from(tick) * period;
         if !plant.is_finite() {
@@ -153,6 +161,7 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
             Sensed::Sample(r) => Some(input(tick, &r)),
             Sensed::Missing => None,
         };
+        obc.send_due(tick, stepper)?;
         let out = stepper.step_with_drive(tick, reading.as_ref(), plant.take_drive_faults())?;
         let command = stepper.reel_command(&out);
         let obs = plant.observe(&command);
@@ -183,7 +192,13 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
             });
         }
         let last = tick == total || history.spool_overrun.is_some();
-        if tick % every == 0 || last {
+        let recorded = tick % every == 0 || last;
+        for packet in stepper.take_telemetry() {
+            if recorded || !obc::is_housekeeping(&packet) {
+                history.telemetry.push(packet);
+            }
+        }
+        if recorded {
             history.samples.push(sample(&obs, t_s, &out));
             if let Some(e) = obs.elastic {
                 history.elastic.push(e);

@@ -32,6 +32,10 @@ pub enum SimError {
     /// The elastic plant's parameters are invalid.
     #[error("{0}")]
     Elastic(#[from] ElasticError),
+    /// The scenario lists telecommands and the controller in the loop has no PUS services to
+    /// take them (the f64 evaluation, a tension law, the PIL link).
+    #[error("the controller in the loop takes no telecommands (only the flight controller linked into the simulator does)")]
+    NoTelecommands,
     /// The plant state stopped being finite (a physically impossible run).
     #[error("the plant state became non-finite at t = {t_s} s")]
     Diverged {
@@ -87,6 +91,19 @@ pub trait Stepper<T> {
     ) -> Result<Output<T>, SimError> {
         let _ = drive;
         self.step(tick, input)
+    }
+
+    /// A telecommand of the on-board computer, before the next control period (`crate::obc`).
+    /// A stepper without the unit's PUS services refuses it.
+    fn telecommand(&mut self, raw: &[u8]) -> Result<(), SimError> {
+        let _ = raw;
+        Err(SimError::NoTelecommands)
+    }
+
+    /// The telemetry packets the unit sent since the last call, in order (none without PUS
+    /// services).
+    fn take_telemetry(&mut self) -> Vec<Vec<u8>> {
+        Vec::new()
     }
 
     /// The reel command of the period `out` was decided for: the rate command and its

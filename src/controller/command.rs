@@ -134,15 +134,11 @@ pub(super) fn transition(
             Ok((Mode::Flying, Effect::BeginStage2))
         }
         (ModeCommand::Retrieve, _) => Err(Refusal::NotInStage1),
-        (ModeCommand::StartDeployment, Mode::Aborted) => {
-            Ok((Mode::Flying, Effect::NewDeployment))
-        }
+        (ModeCommand::StartDeployment, Mode::Aborted) => Ok((Mode::Flying, Effect::NewDeployment)),
         (ModeCommand::StartDeployment, Mode::Flying | Mode::Held { .. }) => {
             Err(Refusal::NotAborted)
         }
-        (ModeCommand::Abort, Mode::Flying | Mode::Held { .. }) => {
-            Ok((Mode::Aborted, Effect::None))
-        }
+        (ModeCommand::Abort, Mode::Flying | Mode::Held { .. }) => Ok((Mode::Aborted, Effect::None)),
         (ModeCommand::Abort, Mode::Aborted) => Err(Refusal::AlreadyAborted),
     }
 }

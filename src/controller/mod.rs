@@ -495,9 +495,7 @@ impl<T: Real> Controller<T> {
         }
         let elapsed_s = T::from_u32(elapsed_ticks) * self.cfg.period_s;
         let predicted_m = self.length.predict(last.rate_mps, elapsed_s);
-        let applied = self
-            .sequencer
-            .apply_pending(&self.cfg, tick, last.rate_mps);
+        let applied = self.sequencer.apply_pending(&self.cfg, tick, last.rate_mps);
         self.events.record(tick, applied.map(EventKind::Command));
         self.sequencer.begin_stage2_if_due(tick, last.rate_mps);
         Period {

@@ -30,7 +30,15 @@ use spacepackets::ecss::{CreatorConfig, MessageTypeId, PusPacket, PusVersion};
 use spacepackets::{CcsdsPacket, PacketType, SpHeader};
 
 pub use crate::controller::ModeCommand;
+use crate::controller::Refusal;
 use crate::link::{ParamTable, PARAM_WORDS};
+
+mod unit;
+
+pub use unit::{
+    event_report, mode_code, read_telemetry, Counts, Housekeeping, Services, Severity, Telemetry,
+    TelemetryPacket, EVENT_LEN, HOUSEKEEPING_LEN, HOUSEKEEPING_SID, MAX_TCS_PER_PERIOD, MAX_TM_LEN,
+};
 
 /// The reel unit's application process identifier (its telecommands and its telemetry).
 pub const APID: u16 = 0x0A5;
@@ -126,6 +134,46 @@ pub enum Reason {
     UnknownFunction = 10,
     /// The parameter table's CRC-32 does not match its words.
     TableChecksum = 11,
+}
+
+/// Why a telecommand failed a verification step: its failure code and 4 bytes of failure data
+/// (docs/interface.md §3, failure codes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Failure {
+    /// The decoder rejected it (codes 1–11).
+    Decode(Reason),
+    /// The mode command is not legal in the current mode and phase (codes 12–17).
+    Mode(Refusal),
+    /// More than [`MAX_TCS_PER_PERIOD`] telecommands in one period (code 18).
+    Flood,
+    /// The parameter table is not the shape of a configuration: the word at fault (code 19).
+    TableShape(u8),
+    /// The core refused the table's configuration (`Config::validate`): the word it names
+    /// (`link::NO_PARAM` for a group) and the rule (`link::rule_code`) (code 20).
+    TableRefused {
+        /// The word at fault.
+        word: u8,
+        /// The rule code.
+        rule: u8,
+    },
+    /// A parameter table after the mission began (code 21): it is loaded only before the
+    /// first step.
+    TooLate,
+}
+
+impl Failure {
+    /// The failure code and failure data of its report.
+    pub fn code_and_data(self) -> (u16, [u8; 4]) {
+        match self {
+            Self::Decode(r) => (r as u16, [0; 4]),
+            Self::Mode(r) => (r as u16, [0; 4]),
+            Self::Flood => (18, [MAX_TCS_PER_PERIOD, 0, 0, 0]),
+            Self::TableShape(word) => (19, [word, 0, 0, 0]),
+            Self::TableRefused { word, rule } => (20, [word, rule, 0, 0]),
+            Self::TooLate => (21, [0; 4]),
+        }
+    }
 }
 
 /// A rejected telecommand: why, and its identity if its header could be read.
@@ -272,13 +320,13 @@ pub const TIME_LEN: usize = 4;
 /// 4, failure code 2 and data 4, packet error control 2.
 pub const MAX_REPORT_LEN: usize = 6 + 7 + TIME_LEN + 4 + 2 + 4 + 2;
 
-/// Writes the TM\[1,x\] report of `request` at `stage` (`failure`: its reason and 4 bytes of
-/// data, e.g. the refused word and rule) into `out`; returns its length. `seq` is the unit's
+/// Writes the TM\[1,x\] report of `request` at `stage` (`failure`: why, as its code and 4
+/// bytes of data, e.g. the refused word and rule) into `out`; returns its length. `seq` is the unit's
 /// telemetry sequence count, `tick` the mission tick of the report.
 pub fn verification_report(
     request: RequestId,
     stage: Stage,
-    failure: Option<(Reason, [u8; 4])>,
+    failure: Option<Failure>,
     seq: u16,
     tick: u32,
     out: &mut [u8],
@@ -296,10 +344,9 @@ pub fn verification_report(
         .copy_from_slice(&request.packet_id.to_be_bytes());
     data.get_mut(2..4)?
         .copy_from_slice(&request.sequence.to_be_bytes());
-    let len = match failure {
-        Some((reason, extra)) => {
-            data.get_mut(4..6)?
-                .copy_from_slice(&(reason as u16).to_be_bytes());
+    let len = match failure.map(Failure::code_and_data) {
+        Some((code, extra)) => {
+            data.get_mut(4..6)?.copy_from_slice(&code.to_be_bytes());
             data.get_mut(6..10)?.copy_from_slice(&extra);
             10
         }
@@ -401,7 +448,7 @@ mod tests {
         let n = verification_report(
             id,
             Stage::Completion,
-            Some((Reason::TableChecksum, [7, 2, 0, 0])),
+            Some(Failure::TableRefused { word: 7, rule: 2 }),
             4,
             7,
             &mut out,
@@ -410,6 +457,6 @@ mod tests {
         assert_eq!(n, MAX_REPORT_LEN);
         let tm = spacepackets::ecss::tm::PusTmReader::new(&out[..n], TIME_LEN).unwrap();
         assert_eq!((tm.service_type_id(), tm.message_subtype_id()), (1, 8));
-        assert_eq!(&tm.source_data()[4..], &[0, 11, 7, 2, 0, 0]);
+        assert_eq!(&tm.source_data()[4..], &[0, 20, 7, 2, 0, 0]);
     }
 }

@@ -37,6 +37,7 @@ pub const ARRAY_TEMPLATES: &[(&str, &str)] = &[
         "{ sensor = \"alpha\", from_s = 100.0, until_s = 200.0, value = 0.0 }",
     ),
     ("faults.length_glitch", "{ at_s = 100.0, size_m = 1.0 }"),
+    ("telecommand", "{ at_s = 100.0, command = \"hold\" }"),
     (
         "montecarlo.dispersion",
         "{ field = \"masses.sub_kg\", distribution = \"normal\", std = 1.0 }",

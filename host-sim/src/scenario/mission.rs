@@ -16,6 +16,7 @@ use super::reel::ReelSection;
 use super::sensors::{FaultsSection, SensorsSection};
 use super::simulation::SimulationSection;
 use super::system::{MassesSection, OrbitSection, TetherSection};
+use super::telecommand::TelecommandSection;
 use super::tension_loop::TensionLoopSection;
 
 /// A complete mission scenario.
@@ -82,4 +83,8 @@ pub struct Scenario {
     /// J2, drag and inclination for the elastic plant (default: none, equatorial).
     #[serde(default)]
     pub environment: EnvironmentSection,
+    /// `[[telecommand]]`: the on-board computer's timed mission-mode commands, sent through
+    /// the unit's PUS services (default: none; only the paper's law takes them).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub telecommand: Vec<TelecommandSection>,
 }

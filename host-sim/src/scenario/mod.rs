@@ -67,6 +67,7 @@ mod schema;
 mod sensors;
 mod simulation;
 mod system;
+mod telecommand;
 mod tension_loop;
 mod validate;
 
@@ -106,4 +107,5 @@ pub use system::{
     MassesSection, OrbitSection, TetherSection, EARTH_EQUATORIAL_RADIUS_M, EARTH_HILL_RADIUS_M,
     MIN_PERIGEE_ALTITUDE_M,
 };
+pub use telecommand::{CommandName, TelecommandSection, MAX_TELECOMMANDS};
 pub use tension_loop::TensionLoopSection;

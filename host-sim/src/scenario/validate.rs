@@ -6,7 +6,8 @@ use super::mission::Scenario;
 use super::plant::PlantModel;
 use super::reel::ReelModelName;
 use super::rules::Validator;
-use super::{core_rules, cost, dispersible};
+use super::control::LawName;
+use super::{core_rules, cost, dispersible, telecommand};
 
 impl Scenario {
     /// Checks that the scenario makes physical sense; returns every failed rule (empty =
@@ -33,6 +34,13 @@ impl Scenario {
         s.tether.check(&mut v);
         s.plant.check(s.controller.period_s, &mut v);
         s.environment.check(&mut v);
+        telecommand::check(&s.telecommand, s.controller.period_s, &mut v);
+        v.check(
+            s.telecommand.is_empty() || s.controller.law == LawName::Paper,
+            "telecommand",
+            format!("{} telecommand(s)", s.telecommand.len()),
+            "only the paper's law (the flight controller) takes telecommands",
+        );
         s.check_elastic_only(&mut v);
         cost::check(s, &mut v);
         // The flight controller's own rules, last (it reports the first it finds).

@@ -1,0 +1,233 @@
+//! The on-board computer commands the reel unit over CCSDS/PUS (docs/interface.md §3): the
+//! commanded missions of `scenarios/` (a hold at 5 h, its resume at 6 h, an abort) fly on the
+//! rigid and the elastic plant, every telecommand is verified, and the telemetry that
+//! `tss-sim run` writes decodes to the same figures as its `history.csv`.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use tss_reel::controller::Flags;
+use tss_reel::pus::{read_telemetry, Stage, Telemetry};
+use tss_sim::history::{History, Sample};
+use tss_sim::scenario::Scenario;
+
+fn scenario_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../scenarios/{name}.toml"))
+}
+
+fn fly(name: &str) -> History {
+    let sc = Scenario::load(scenario_path(name), &[]).expect("the scenario loads");
+    tss_sim::sim::run(&sc, &[], &mut |_| {}).expect("the mission flies")
+}
+
+/// The verification reports of a run: (request sequence count, stage, failure code).
+fn verification(h: &History) -> Vec<(u16, Stage, Option<u16>)> {
+    h.telemetry
+        .iter()
+        .filter_map(|p| match read_telemetry(p)?.telemetry {
+            Telemetry::Verification {
+                request,
+                stage,
+                failure,
+            } => Some((request.sequence & 0x3fff, stage, failure.map(|f| f.0))),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The samples from `from_s` to `until_s`.
+fn between(h: &History, from_s: f64, until_s: f64) -> impl Iterator<Item = &Sample> {
+    h.samples
+        .iter()
+        .filter(move |s| s.t_s >= from_s && s.t_s <= until_s)
+}
+
+const OK: Option<u16> = None;
+const HOLD_S: f64 = 18_000.0;
+const RESUME_S: f64 = 21_600.0;
+
+/// A hold at 5 h: the reel at rest within `rest_s` and the length kept until the resume at
+/// 6 h, held and flagged throughout; then the law again (no safe action); stage 2 one hour
+/// late, at 9 h.
+fn assert_held_and_resumed(h: &History, rest_s: f64) {
+    let held: Vec<&Sample> = between(h, HOLD_S + rest_s, RESUME_S - 10.0).collect();
+    assert!(held.len() > 300);
+    for s in &held {
+        assert_eq!(s.length_rate_mps, 0.0, "at rest: {s:?}");
+        assert_eq!(s.length_m, held[0].length_m, "the length kept: {s:?}");
+    }
+    for s in between(h, HOLD_S, RESUME_S - 10.0) {
+        assert!(
+            Flags(s.flags).contains(Flags::HELD | Flags::SAFE_ACTION),
+            "{s:?}"
+        );
+    }
+    for s in between(h, RESUME_S + 10.0, 32_390.0) {
+        assert_eq!(s.flags & (Flags::HELD | Flags::SAFE_ACTION), 0, "{s:?}");
+        assert_eq!(s.phase.as_str(), "keep1");
+    }
+    let slew = h.samples.iter().find(|s| s.phase.as_str() == "slew");
+    assert_eq!(slew.map(|s| s.t_s), Some(32_400.0), "stage 2 at 9 h");
+}
+
+#[test]
+fn the_paper_mission_holds_resumes_and_refuses_a_resume_it_cannot_take() {
+    let h = fly("paper-commanded");
+    // 0.0024 m/s at 5 h, ramped down at 15 m/s²: at rest within a period.
+    assert_held_and_resumed(&h, 10.0);
+    assert_eq!(
+        verification(&h),
+        [
+            (0, Stage::Acceptance, OK),
+            (0, Stage::Start, OK),
+            (0, Stage::Completion, OK),
+            (1, Stage::Acceptance, OK),
+            (1, Stage::Start, OK),
+            (1, Stage::Completion, OK),
+            (2, Stage::Acceptance, OK),
+            (2, Stage::Start, Some(14)),
+        ]
+    );
+    assert_eq!(h.faults.slack_s, 0.0, "taut throughout");
+}
+
+#[test]
+fn the_elastic_mission_holds_resumes_and_aborts_to_rest() {
+    let h = fly("paper-elastic-commanded");
+    assert_held_and_resumed(&h, 100.0);
+    // The abort at 11 h, retrieving at 0.36 m/s: at rest at 0.01 m/s² within 36 s, and the
+    // length kept to the end.
+    let abort_s = 39_600.0;
+    let rest: Vec<&Sample> = between(&h, abort_s + 40.0, 72_000.0).collect();
+    assert_eq!(rest.last().map(|s| s.t_s), Some(72_000.0));
+    for s in &rest {
+        assert_eq!(s.length_rate_mps, 0.0, "{s:?}");
+        assert_eq!(s.length_m, rest[0].length_m, "{s:?}");
+        assert!(Flags(s.flags).contains(Flags::ABORTED | Flags::SAFE_ACTION));
+    }
+    assert_eq!(
+        verification(&h)
+            .iter()
+            .filter(|(_, stage, f)| *stage == Stage::Completion && f.is_none())
+            .count(),
+        3
+    );
+    // Held and resumed, the elastic tether stays taut; brought to rest while retrieving, it
+    // does not (docs/equations.md §7.1: no tension loop in a hold).
+    let slack_before_abort = h
+        .faults
+        .slack_episodes
+        .iter()
+        .filter(|e| e.0 < abort_s)
+        .count();
+    assert_eq!(slack_before_abort, 0);
+    eprintln!(
+        "elastic abort at 11 h: slack {} episodes, {} s in all",
+        h.faults.slack_events, h.faults.slack_s
+    );
+}
+
+#[test]
+fn an_abort_after_a_fault_brings_the_reel_to_rest_for_good() {
+    let h = fly("faults-commanded");
+    // Retrieving at 0.25 m/s after the orbit-rate fault at 40 000 s; aborted at 40 010 s and
+    // brought to rest at 0.01 m/s² (the command in 26 s; the reel, with its 1 s lag, within a
+    // minute).
+    let rest: Vec<&Sample> = between(&h, 40_010.0 + 60.0, 72_000.0).collect();
+    for s in &rest {
+        assert_eq!(s.length_rate_mps, 0.0, "{s:?}");
+        assert_eq!(s.length_m, rest[0].length_m, "{s:?}");
+        assert!(Flags(s.flags).contains(Flags::ABORTED));
+    }
+    let libration = rest.iter().map(|s| s.alpha_rad.abs()).fold(0.0, f64::max);
+    assert!(libration < 0.1, "a free swing of {libration} rad at rest");
+    assert_eq!(verification(&h).len(), 9);
+}
+
+/// A CSV file as rows of named cells.
+fn read_csv(path: &Path) -> Vec<HashMap<String, String>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    lines
+        .map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            assert_eq!(cells.len(), header.len(), "{l}");
+            header
+                .iter()
+                .cloned()
+                .zip(cells.iter().map(|c| c.to_string()))
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn the_telemetry_run_writes_decodes_to_the_figures_of_its_history() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let status = Command::new(env!("CARGO_BIN_EXE_tss-sim"))
+        .args(["-q", "run"])
+        .arg(scenario_path("paper-commanded"))
+        .arg("-o")
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let history = read_csv(&out.join("history.csv"));
+    let telemetry = read_csv(&out.join("telemetry.csv"));
+    let housekeeping: HashMap<&str, &HashMap<String, String>> = telemetry
+        .iter()
+        .filter(|r| r["service"] == "3")
+        .map(|r| (r["tick"].as_str(), r))
+        .collect();
+    // One housekeeping report per history row (1 s period: the tick is t_s).
+    assert_eq!(housekeeping.len(), history.len());
+    let phases = ["deploy", "keep1", "slew", "retrieve", "keep2"];
+    let number = |s: &str| s.parse::<f64>().unwrap();
+    for row in &history {
+        let hk = housekeeping[row["t_s"].as_str()];
+        for (h, t) in [
+            ("length_rate_mps", "rate_cmd_mps"),
+            ("length_accel_mps2", "accel_cmd_mps2"),
+            ("law_rate_mps", "law_rate_mps"),
+            ("blend_weight", "blend_weight"),
+            ("alpha_ref_rad", "alpha_ref_rad"),
+            ("delta_rad", "delta_rad"),
+            ("delta_rate_radps", "delta_rate_radps"),
+        ] {
+            assert_eq!(number(&row[h]), number(&hk[t]), "{h} at {}", row["t_s"]);
+        }
+        assert_eq!(row["flags"], hk["flags"]);
+        assert_eq!(row["phase"], phases[hk["phase"].parse::<usize>().unwrap()]);
+        // The paper's sensors are exact: the sensed α is the plant's, rounded to f32.
+        let alpha = number(&row["alpha_rad"]) as f32;
+        assert_eq!(number(&hk["alpha_rad"]), f64::from(alpha));
+    }
+    // Every verification report and event of the run is there, with its time.
+    let reports: Vec<(&str, &str, &str)> = telemetry
+        .iter()
+        .filter(|r| r["service"] == "1")
+        .map(|r| {
+            (
+                r["t_s"].as_str(),
+                r["subtype"].as_str(),
+                r["failure_code"].as_str(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        reports,
+        [
+            ("17999", "1", ""),
+            ("17999", "3", ""),
+            ("18000", "7", ""),
+            ("21599", "1", ""),
+            ("21599", "3", ""),
+            ("21600", "7", ""),
+            ("25199", "1", ""),
+            ("25199", "4", "14"),
+        ]
+    );
+}
