@@ -14,11 +14,15 @@ use crate::scenario::Scenario;
 use crate::stepper::{ticks, SimError, Stepper};
 
 /// The reel unit as the on-board computer sees it: the flight controller (f32) behind its PUS
-/// services. Its telemetry is kept until [`Stepper::take_telemetry`].
+/// services. Its telemetry is kept until [`Stepper::take_telemetry`], which asks for the
+/// housekeeping of the last step only when it is kept (the closed loop keeps it at the output
+/// interval: service 3's collection interval).
 pub struct Unit {
     controller: Controller<f32>,
     services: Services,
     sent: Vec<Vec<u8>>,
+    /// The last step's sample, for its housekeeping.
+    last_input: Option<Input<f32>>,
 }
 
 impl Unit {
@@ -28,14 +32,16 @@ impl Unit {
             controller,
             services: Services::new(),
             sent: Vec::new(),
+            last_input: None,
         }
     }
 
-    /// After a step on `input`: the services' telemetry of it.
+    /// After a step on `input`: the services' verification and events of it.
     fn report(&mut self, input: Option<&Input<f32>>) -> Output<f32> {
         let sent = &mut self.sent;
         self.services
-            .after_step(&mut self.controller, input, &mut |p| sent.push(p.to_vec()));
+            .report_events(&mut self.controller, &mut |p| sent.push(p.to_vec()));
+        self.last_input = input.copied();
         *self.controller.output()
     }
 }
@@ -66,7 +72,15 @@ impl Stepper<f32> for Unit {
         Ok(())
     }
 
-    fn take_telemetry(&mut self) -> Vec<Vec<u8>> {
+    fn take_telemetry(&mut self, housekeeping: bool) -> Vec<Vec<u8>> {
+        if housekeeping {
+            let sent = &mut self.sent;
+            self.services.report_housekeeping(
+                &self.controller,
+                self.last_input.as_ref(),
+                &mut |p| sent.push(p.to_vec()),
+            );
+        }
         std::mem::take(&mut self.sent)
     }
 }
@@ -114,14 +128,6 @@ impl Obc {
         }
         Ok(())
     }
-}
-
-/// Is `raw` a housekeeping report? (The closed loop keeps those at the output interval only.)
-pub fn is_housekeeping(raw: &[u8]) -> bool {
-    matches!(
-        read_telemetry(raw).map(|p| p.telemetry),
-        Some(Telemetry::Housekeeping(_))
-    )
 }
 
 /// The packets of a run, by kind.

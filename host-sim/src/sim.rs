@@ -16,7 +16,7 @@ use crate::elastic::{ElasticParams, ElasticPlant, InitialConditions};
 use crate::faults::{InjectionPlan, Injector, Reading, Sensed, SummaryBuilder, TickRecord, Truth};
 use crate::history::{History, PhaseLabel, Sample, SpoolOverrun};
 use crate::laws::LawStepper;
-use crate::obc::{self, Obc, Unit};
+use crate::obc::{Obc, Unit};
 use crate::plant::{ix, Command, Observation, Plant, RigidModel, RigidPlant, State};
 use crate::reel::{Reel, ReelDrive};
 use crate::scenario::{PlantModel, Scenario};
@@ -193,11 +193,7 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
         }
         let last = tick == total || history.spool_overrun.is_some();
         let recorded = tick % every == 0 || last;
-        for packet in stepper.take_telemetry() {
-            if recorded || !obc::is_housekeeping(&packet) {
-                history.telemetry.push(packet);
-            }
-        }
+        history.telemetry.extend(stepper.take_telemetry(recorded));
         if recorded {
             history.samples.push(sample(&obs, t_s, &out));
             if let Some(e) = obs.elastic {

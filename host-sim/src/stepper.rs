@@ -100,9 +100,10 @@ pub trait Stepper<T> {
         Err(SimError::NoTelecommands)
     }
 
-    /// The telemetry packets the unit sent since the last call, in order (none without PUS
-    /// services).
-    fn take_telemetry(&mut self) -> Vec<Vec<u8>> {
+    /// The telemetry packets the unit sent since the last call, in order, with the
+    /// housekeeping of the last step if `housekeeping` (none without PUS services).
+    fn take_telemetry(&mut self, housekeeping: bool) -> Vec<Vec<u8>> {
+        let _ = housekeeping;
         Vec::new()
     }
 

@@ -528,6 +528,14 @@ impl Services {
         sample: Option<&Input<f32>>,
         emit: &mut dyn FnMut(&[u8]),
     ) {
+        self.report_events(ctl, emit);
+        self.report_housekeeping(ctl, sample, emit);
+    }
+
+    /// The first half of [`Services::after_step`]: the completion of a mode command the step
+    /// applied and the step's events. A caller that collects housekeeping at a longer interval
+    /// than the period calls this each period and [`Services::report_housekeeping`] when due.
+    pub fn report_events(&mut self, ctl: &mut Controller<f32>, emit: &mut dyn FnMut(&[u8])) {
         self.started = true;
         self.last_tick = ctl.output().tick;
         self.tcs_this_period = 0;
@@ -542,6 +550,16 @@ impl Services {
             data[2..].copy_from_slice(&aux);
             self.send(5, severity as u8, &data, emit);
         }
+    }
+
+    /// The second half of [`Services::after_step`]: the housekeeping of the last step of
+    /// `ctl`, on `sample`.
+    pub fn report_housekeeping(
+        &mut self,
+        ctl: &Controller<f32>,
+        sample: Option<&Input<f32>>,
+        emit: &mut dyn FnMut(&[u8]),
+    ) {
         let hk = Housekeeping::of(ctl, sample).to_bytes();
         self.send(3, 25, &hk, emit);
     }
