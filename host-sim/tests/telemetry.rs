@@ -74,7 +74,8 @@ fn assert_held_and_resumed(h: &History, rest_s: f64) {
 #[test]
 fn the_paper_mission_holds_resumes_and_refuses_a_resume_it_cannot_take() {
     let h = fly("paper-commanded");
-    // 0.0024 m/s at 5 h, ramped down at 15 m/s²: at rest within a period.
+    // −0.013 m/s at 5 h, ramped down at 0.01 m/s² (monitor.safe_hold_decel_mps2): at rest
+    // from the second period of the hold.
     assert_held_and_resumed(&h, 10.0);
     assert_eq!(
         verification(&h),
