@@ -495,14 +495,25 @@ impl<T: Real> Controller<T> {
         }
         let elapsed_s = T::from_u32(elapsed_ticks) * self.cfg.period_s;
         let predicted_m = self.length.predict(last.rate_mps, elapsed_s);
-        let applied = self.sequencer.apply_pending(&self.cfg, tick, last.rate_mps);
-        self.events.record(tick, applied.map(EventKind::Command));
+        if self.sequencer.command_waits() {
+            self.apply_command(tick, last.rate_mps);
+        }
         self.sequencer.begin_stage2_if_due(tick, last.rate_mps);
         Period {
             tick,
             elapsed_ticks,
             predicted_m,
         }
+    }
+
+    /// The mode command that waits, applied at the boundary `tick` with the reel at `rate_mps`
+    /// ([`EventKind::Command`]).
+    // Out of line: a command waits in few periods, and inlined into the step its code made
+    // every step longer (scripts/bench-target).
+    #[inline(never)]
+    fn apply_command(&mut self, tick: u32, rate_mps: T) {
+        let applied = self.sequencer.apply_pending(&self.cfg, tick, rate_mps);
+        self.events.record(tick, applied.map(EventKind::Command));
     }
 
     /// Check the sample ([`crate::monitor`]). Before the first accepted sample, and in safe

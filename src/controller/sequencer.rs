@@ -241,6 +241,11 @@ impl<T: Real> Sequencer<T> {
         self.mode
     }
 
+    /// A command waits for the next period boundary.
+    pub(super) fn command_waits(&self) -> bool {
+        self.pending.is_some()
+    }
+
     /// Takes `command` for the next period boundary if it is legal in the current mode and
     /// phase ([`transition`]) and no other command waits; a refused one changes nothing.
     pub(super) fn command(&mut self, command: ModeCommand) -> Result<(), Refusal> {
