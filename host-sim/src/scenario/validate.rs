@@ -1,12 +1,12 @@
 //! The scenario's validation: every section's rules, the rules between sections, what an
 //! elastic run will cost, then the flight controller's own rules ([`Scenario::problems`]).
 
+use super::control::LawName;
 use super::error::Problem;
 use super::mission::Scenario;
 use super::plant::PlantModel;
 use super::reel::ReelModelName;
 use super::rules::Validator;
-use super::control::LawName;
 use super::{core_rules, cost, dispersible, telecommand};
 
 impl Scenario {
