@@ -203,8 +203,9 @@ struct Unusable<T> {
 enum Sequenced<T> {
     /// The law flies on this reference.
     Law(Reference<T>),
-    /// Safe hold goes on until the inputs have recovered; α_r at the sensed length, rad.
-    Recovering { alpha_ref_rad: T },
+    /// The reel stays held: safe hold until the inputs have recovered, or a hold by command;
+    /// α_r at the sensed length, rad.
+    Held { alpha_ref_rad: T },
 }
 
 /// The law's solution of this period (Eqs. 27, 29, 30): the command it asks for before the
@@ -448,15 +449,8 @@ impl<T: Real> Controller<T> {
         };
         let reference = match self.sequence(tick, &sensed) {
             Sequenced::Law(reference) => reference,
-            Sequenced::Recovering { alpha_ref_rad } => {
-                return self.hold(tick, true, alpha_ref_rad, None)
-            }
+            Sequenced::Held { alpha_ref_rad } => return self.hold(tick, true, alpha_ref_rad, None),
         };
-        if self.sequencer.mode().holds() {
-            // A usable sample the commanded hold does not fly the law on.
-            self.health.usable();
-            return self.hold(tick, true, reference.angle.angle_rad, None);
-        }
         let solved = match self.law(tick, &sensed, &reference) {
             Ok(solved) => solved,
             Err(unusable) => return self.reject(tick, unusable),
@@ -512,7 +506,7 @@ impl<T: Real> Controller<T> {
     // every step longer (scripts/bench-target).
     #[inline(never)]
     fn apply_command(&mut self, tick: u32, rate_mps: T) {
-        let applied = self.sequencer.apply_pending(&self.cfg, tick, rate_mps);
+        let applied = self.sequencer.apply_pending(tick, rate_mps);
         self.events.record(tick, applied.map(EventKind::Command));
     }
 
@@ -598,7 +592,8 @@ impl<T: Real> Controller<T> {
 
     /// Sequence the mission (docs/equations.md §7): α_r of the phase at the sensed length. In
     /// safe hold the law re-engages only once the inputs have recovered, through the Eq. 29
-    /// blend restarted from the current rate.
+    /// blend restarted from the current rate; held by command (§7.1), it does not, and the
+    /// sample counts as usable.
     fn sequence(&mut self, tick: u32, s: &Sensed<T>) -> Sequenced<T> {
         let x = s.input;
         let reference = self
@@ -607,10 +602,15 @@ impl<T: Real> Controller<T> {
         if self.health.health() == Health::SafeHold {
             if !self.health.recovered(&self.cfg.monitor) {
                 let alpha_ref_rad = reference.angle.angle_rad;
-                return Sequenced::Recovering { alpha_ref_rad };
+                return Sequenced::Held { alpha_ref_rad };
             }
             self.sequencer
                 .restart_blend(tick, self.last_command.rate_mps);
+        }
+        if self.sequencer.mode().holds() {
+            self.health.usable();
+            let alpha_ref_rad = reference.angle.angle_rad;
+            return Sequenced::Held { alpha_ref_rad };
         }
         Sequenced::Law(reference)
     }

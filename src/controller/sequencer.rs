@@ -157,6 +157,8 @@ pub(super) struct Sequencer<T> {
     /// The tick the current stage began at.
     stage_start_tick: u32,
     stage2: Stage2Start,
+    /// When stage 2 begins as configured (a new deployment starts from it again).
+    configured_stage2: Stage2Start,
     blend: CarriedBlend<T>,
     /// How many times a blend has (re)started (wrapping): a restart is an event.
     blend_restarts: u32,
@@ -204,14 +206,16 @@ impl<T: Real> Sequencer<T> {
             // (`as` saturates: a window beyond u32 never elapses.)
             libm::ceil(ticks) as u32
         };
+        let stage2 = match cfg.stage2.start_tick {
+            Some(tick) => Stage2Start::At(tick),
+            None => Stage2Start::OnRequest,
+        };
         Self {
             phase: Phase::Deploy,
             mission_start_tick: 0,
             stage_start_tick: 0,
-            stage2: match cfg.stage2.start_tick {
-                Some(tick) => Stage2Start::At(tick),
-                None => Stage2Start::OnRequest,
-            },
+            stage2,
+            configured_stage2: stage2,
             blend: CarriedBlend::new(
                 0,
                 cfg.initial_rate_mps,
@@ -261,14 +265,8 @@ impl<T: Real> Sequencer<T> {
     /// command that waits, if any, and returns it. A hold ends with its effect on the
     /// mission's clock: the stage-2 start and the slew are moved on by the ticks it lasted, so
     /// the phase held goes on as it was, its blend restarted from the current rate. A new
-    /// deployment is stage 1 afresh from now, from the current rate (`cfg`: the configuration
-    /// the sequencer was made from).
-    pub(super) fn apply_pending(
-        &mut self,
-        cfg: &Config<T>,
-        tick: u32,
-        rate_mps: T,
-    ) -> Option<ModeCommand> {
+    /// deployment is stage 1 afresh from now, from the current rate, stage 2 as configured.
+    pub(super) fn apply_pending(&mut self, tick: u32, rate_mps: T) -> Option<ModeCommand> {
         let command = self.pending.take()?;
         // Judged when it was given, against the mode and phase it meets here (nothing changes
         // them between two steps): not refused now.
@@ -283,9 +281,8 @@ impl<T: Real> Sequencer<T> {
             }
             Effect::BeginStage2 => self.request_stage2(),
             Effect::NewDeployment => {
-                let restarts = self.blend_restarts;
-                *self = Self::new(cfg);
-                self.blend_restarts = restarts;
+                self.phase = Phase::Deploy;
+                self.stage2 = self.configured_stage2;
                 self.mission_start_tick = tick;
                 self.stage_start_tick = tick;
                 self.restart_blend(tick, rate_mps);
