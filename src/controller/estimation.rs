@@ -2,13 +2,15 @@
 //! flies [`RateSource::Estimator`](crate::config::RateSource::Estimator): each step carries the
 //! estimate over the period that just ended under the drive the last step commanded (or the
 //! reel's measured rate), updates it with this period's α, and says whether the law may fly on
-//! it (see the controller's docs, *Flying on the estimator*).
+//! it (see the controller's docs, *Flying on the estimator*). With a tension loop configured,
+//! the drive is the range between the satellites, the reel's length stretched by the load
+//! cell's tension (docs/equations.md §13.2).
 
-use crate::config::{estimator_error, ConfigError};
+use crate::config::{estimator_error, ConfigError, TensionLoopConfig};
 use crate::estimator::{
     self, Drive, DriveError, Estimate, Estimator, Measurement, OrbitTerms, Prediction,
 };
-use crate::monitor::Sensor;
+use crate::monitor::{Input, Sensor};
 use crate::orbit::Orbit;
 use crate::real::Real;
 
@@ -50,6 +52,30 @@ pub(super) struct Commanded<T> {
     pub(super) mu3: T,
 }
 
+/// The tether's stretch, as the drive counts it (docs/equations.md §13.2): the range between
+/// the satellites is the unstretched length l plus e = l·T/EA, T the load cell's tension.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Stretch<T> {
+    /// 1/EA, the compliance the tension loop is told (`TensionLoopConfig::axial_stiffness_n`),
+    /// 1/N.
+    compliance_per_n: T,
+    /// The largest tension counted, N (the loop's `max_tension_n`, the most the reel is asked
+    /// to hold): a reading beyond it stretches the tether by no more, so one corrupt sample
+    /// moves the drive by a bounded step.
+    max_tension_n: T,
+    /// e at the last step's sample, m (`None`: that sample had no usable tension).
+    last_m: Option<T>,
+}
+
+impl<T: Real> Stretch<T> {
+    /// e = l·T/EA of a sample (`None` without a usable tension: absent, not finite). A
+    /// negative reading is a slack tether (no stretch).
+    fn of(&self, x: &Input<T>) -> Option<T> {
+        let t = x.tension_n.filter(|t| t.is_finite())?;
+        Some(x.length_m * t.clamp_to(T::ZERO, self.max_tension_n) * self.compliance_per_n)
+    }
+}
+
 /// What the estimator made of this step's sample, for the law and the fault logic.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) enum Estimated<T> {
@@ -75,6 +101,8 @@ pub(super) struct Estimation<T: Real> {
     orbit: Result<OrbitTerms<T>, DriveError>,
     /// What the last step commanded (`None` before the first step).
     commanded: Option<Commanded<T>>,
+    /// The tether's stretch (`None`: no tension loop, a rigid tether's drive).
+    stretch: Option<Stretch<T>>,
     /// The NIS of the last step's α sample, if one met the estimate.
     nis: Option<T>,
     /// The estimate was found useless, and no α has been used since: it stays useless (its α
@@ -84,8 +112,13 @@ pub(super) struct Estimation<T: Real> {
 }
 
 impl<T: Real> Estimation<T> {
-    /// The estimator of `cfg` (validated with the controller's configuration) on `orbit`.
-    pub(super) fn new(cfg: &estimator::Config<T>, orbit: &Orbit<T>) -> Result<Self, ConfigError> {
+    /// The estimator of `cfg` (validated with the controller's configuration) on `orbit`; with
+    /// the tension loop `tension`, its drive counts the tether's stretch.
+    pub(super) fn new(
+        cfg: &estimator::Config<T>,
+        orbit: &Orbit<T>,
+        tension: Option<&TensionLoopConfig<T>>,
+    ) -> Result<Self, ConfigError> {
         let filter = Estimator::new(*cfg).map_err(estimator_error)?;
         let max_alpha_var_rad2 =
             T::from_f64(MAX_ALPHA_VARIANCE_IN_SAMPLES) * filter.measurement_var_rad2();
@@ -101,6 +134,11 @@ impl<T: Real> Estimation<T> {
                 orbit.gravity_gradient_per_s2(T::ZERO),
             ),
             commanded: None,
+            stretch: tension.map(|t| Stretch {
+                compliance_per_n: T::ONE / t.axial_stiffness_n,
+                max_tension_n: t.max_tension_n,
+                last_m: None,
+            }),
             nis: None,
             useless: false,
         })
@@ -126,22 +164,23 @@ impl<T: Real> Estimation<T> {
     }
 
     /// One step: carries the estimate over the `periods` that passed since the last step
-    /// (0 at the first), the reel having run at its measured rate `reel_rate_mps` (if the
-    /// encoder gave one) or at the last command, then updates it with this period's α
-    /// (`None`: the swing sensor gave nothing, or the sample was rejected). `orbit_rate_radps`
-    /// and `true_anomaly_rad` are those of an accepted sample (`None`: the last ones hold).
-    /// Returns the verdict and the event it makes, if any.
+    /// (0 at the first), the reel having run at the accepted `sample`'s measured rate (if the
+    /// encoder gave one) or at the last command, the tether stretched as its load cell says
+    /// (with a tension loop), then updates it with this period's α (`None`: the swing sensor
+    /// gave nothing, or the sample was rejected). The orbit's terms are those of the accepted
+    /// sample (`None`: the last ones hold). Returns the verdict and the event it makes, if any.
     pub(super) fn step(
         &mut self,
         periods: u32,
-        sample: Option<(T, T, Option<T>)>,
+        sample: Option<&Input<T>>,
         alpha_rad: Option<T>,
     ) -> (Estimated<T>, Option<EventKind>) {
         let mut reel_rate_mps = None;
-        if let Some((orbit_rate_radps, true_anomaly_rad, measured)) = sample {
-            self.sense_orbit(orbit_rate_radps, true_anomaly_rad);
-            reel_rate_mps = measured;
+        if let Some(x) = sample {
+            self.sense_orbit(x.orbit_rate_radps, x.true_anomaly_rad);
+            reel_rate_mps = x.reel_rate_mps;
         }
+        let stretch_rate_mps = self.sense_stretch(periods, sample);
         // The last period with the encoder's rate (that of the period that just ended), after
         // the periods of a gap in the calls. One period, the common case, tested first.
         let lost = match periods {
@@ -149,7 +188,7 @@ impl<T: Real> Estimation<T> {
             1..=MAX_CARRIED_PERIODS => {
                 // The periods of a gap in the calls at the last command, then the last one.
                 let gap_lost = periods > 1 && self.carry_gap(periods - 1);
-                let last_lost = self.carry(periods - 1, reel_rate_mps);
+                let last_lost = self.carry(periods - 1, reel_rate_mps, stretch_rate_mps);
                 gap_lost || last_lost
             }
             _ => {
@@ -192,18 +231,39 @@ impl<T: Real> Estimation<T> {
         (verdict, event)
     }
 
+    /// The stretch's mean rate over the period that just ended, m/s: the change of e = l·T/EA
+    /// from the last step's sample to this one's, when both had a tension and one period
+    /// passed (0 otherwise: the drive is then the reel's alone). Keeps this sample's e.
+    fn sense_stretch(&mut self, periods: u32, sample: Option<&Input<T>>) -> T {
+        let Some(stretch) = &mut self.stretch else {
+            return T::ZERO;
+        };
+        let now_m = sample.and_then(|x| stretch.of(x));
+        let rate_mps = match (periods, stretch.last_m, now_m) {
+            (1, Some(last_m), Some(now_m)) => (now_m - last_m) / self.filter.config().period_s,
+            _ => T::ZERO,
+        };
+        stretch.last_m = now_m;
+        rate_mps
+    }
+
     /// Carries the estimate over the `k`-th period since the last step (see [`Self::drive`]);
     /// `true` if the filter dropped it. Without a command yet the estimate is dropped
     /// (nothing says how the reel moved); with orbit terms refused, too (as a refused drive).
-    fn carry(&mut self, k: u32, reel_rate_mps: Option<T>) -> bool {
+    fn carry(&mut self, k: u32, reel_rate_mps: Option<T>, stretch_rate_mps: T) -> bool {
         let Some(c) = self.commanded else {
             self.filter.reset();
             return false;
         };
         match self.orbit {
             Ok(orbit) => matches!(
-                self.filter
-                    .predict_period(&self.drive(&c, orbit, k, reel_rate_mps)),
+                self.filter.predict_period(&self.drive(
+                    &c,
+                    orbit,
+                    k,
+                    reel_rate_mps,
+                    stretch_rate_mps
+                )),
                 Prediction::InvalidDrive(_) | Prediction::Diverged
             ),
             Err(_) => {
@@ -223,7 +283,7 @@ impl<T: Real> Estimation<T> {
     fn carry_gap(&mut self, periods: u32) -> bool {
         let mut lost = false;
         for k in 0..periods {
-            lost |= self.carry(k, None);
+            lost |= self.carry(k, None, T::ZERO);
         }
         lost
     }
@@ -244,19 +304,21 @@ impl<T: Real> Estimation<T> {
     /// The drive of the `k`-th period since the last step: the last step's command `c`, its
     /// length advanced by k periods of it; the rate measured over the period when the encoder
     /// gave one (taken as the period's mean: the drive's rate at mid-period, so its start rate
-    /// is the mean less half the period's commanded change).
+    /// is the mean less half the period's commanded change); plus the stretch's mean rate over
+    /// the period (docs/equations.md §13.2; 0 without a tension loop).
     fn drive(
         &self,
         c: &Commanded<T>,
         orbit: OrbitTerms<T>,
         k: u32,
         reel_rate_mps: Option<T>,
+        stretch_rate_mps: T,
     ) -> Drive<T> {
         let h = self.filter.config().period_s;
         let rate_mps = match reel_rate_mps {
             Some(mean) => mean - T::from_f64(0.5) * c.accel_mps2 * h,
             None => c.rate_mps,
-        };
+        } + stretch_rate_mps;
         Drive {
             length_m: c.length_m + c.rate_mps * T::from_u32(k) * h,
             rate_mps,
@@ -271,10 +333,73 @@ impl<T: Real> Estimation<T> {
 mod tests {
     use super::*;
 
+    /// An accepted sample at the orbit rate `n`, the length `length_m` and the load cell's
+    /// `tension_n`.
+    fn sample(n: f64, length_m: f64, tension_n: Option<f64>) -> Input<f64> {
+        Input {
+            tick: 0,
+            length_m,
+            reel_rate_mps: None,
+            tension_n,
+            alpha_rad: Some(0.3),
+            alpha_rate_radps: None,
+            orbit_rate_radps: n,
+            true_anomaly_rad: 0.0,
+        }
+    }
+
+    /// With a tension loop the drive's rate is the range's: the reel's plus the change of
+    /// l·T/EA over the period; a tension beyond the loop's `max_tension_n` stretches no more,
+    /// a period without a tension (or a gap) adds nothing.
+    #[test]
+    fn the_drive_counts_the_stretch_the_load_cell_measures() {
+        let cfg = estimator::Config::<f64>::paper();
+        let loop_cfg = TensionLoopConfig::<f64>::dyneema_half_mm();
+        let orbit = Orbit::circular(7_078_000.0);
+        let mut e = Estimation::new(&cfg, &orbit, Some(&loop_cfg)).unwrap();
+        let n = 1.06e-3;
+        let ea = loop_cfg.axial_stiffness_n;
+        assert_eq!(
+            e.sense_stretch(0, Some(&sample(n, 20_000.0, Some(5.0)))),
+            0.0
+        );
+        // 5 → 6 N at 20 km: 2 m more of stretch in one period.
+        let rate = e.sense_stretch(1, Some(&sample(n, 20_000.0, Some(6.0))));
+        assert!((rate - 20_000.0 * 1.0 / ea).abs() < 1e-12, "{rate}");
+        let c = Commanded {
+            length_m: 20_000.0,
+            rate_mps: -3.0,
+            accel_mps2: 0.0,
+            mu3: 0.01,
+        };
+        let terms = OrbitTerms::circular(n).unwrap();
+        assert_eq!(e.drive(&c, terms, 0, None, rate).rate_mps, -3.0 + rate);
+        // A corrupt reading counts as the loop's largest tension.
+        let rate = e.sense_stretch(1, Some(&sample(n, 20_000.0, Some(1e4))));
+        let most = 20_000.0 * (loop_cfg.max_tension_n - 6.0) / ea;
+        assert!((rate - most).abs() < 1e-9, "{rate}");
+        // No tension, a gap, or no loop: the reel's drive alone.
+        assert_eq!(e.sense_stretch(1, Some(&sample(n, 20_000.0, None))), 0.0);
+        assert_eq!(
+            e.sense_stretch(1, Some(&sample(n, 20_000.0, Some(5.0)))),
+            0.0
+        );
+        assert_eq!(
+            e.sense_stretch(2, Some(&sample(n, 20_000.0, Some(6.0)))),
+            0.0
+        );
+        let mut rigid = Estimation::new(&cfg, &orbit, None).unwrap();
+        let _ = rigid.sense_stretch(0, Some(&sample(n, 20_000.0, Some(5.0))));
+        assert_eq!(
+            rigid.sense_stretch(1, Some(&sample(n, 20_000.0, Some(6.0)))),
+            0.0
+        );
+    }
+
     #[test]
     fn the_drive_takes_the_orbit_terms_from_theta_on_an_eccentric_orbit_only() {
         let cfg = estimator::Config::<f64>::paper();
-        let mut circular = Estimation::new(&cfg, &Orbit::circular(7_078_000.0)).unwrap();
+        let mut circular = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), None).unwrap();
         let n = 1.06e-3;
         circular.sense_orbit(n, 2.0);
         let t = circular.orbit.unwrap();
@@ -282,7 +407,7 @@ mod tests {
         assert_eq!(t.accel_radps2().to_bits(), 0.0_f64.to_bits());
         assert_eq!(t.gravity_gradient_per_s2(), n * n);
         let orbit = Orbit::elliptic(7_078_000.0, 0.1);
-        let mut eccentric = Estimation::new(&cfg, &orbit).unwrap();
+        let mut eccentric = Estimation::new(&cfg, &orbit, None).unwrap();
         let theta = 2.0;
         eccentric.sense_orbit(n, theta);
         let t = eccentric.orbit.unwrap();
@@ -298,7 +423,7 @@ mod tests {
     #[test]
     fn refused_orbit_terms_drop_the_estimate_as_a_refused_drive() {
         let cfg = estimator::Config::<f64>::paper();
-        let mut e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0)).unwrap();
+        let mut e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), None).unwrap();
         let c = Commanded {
             length_m: 100.0,
             rate_mps: 2.0,
@@ -306,11 +431,12 @@ mod tests {
             mu3: 0.01,
         };
         e.end_step(c);
-        let (verdict, event) = e.step(0, Some((1.06e-3, 0.0, None)), Some(-0.5));
+        let x = sample(1.06e-3, 100.0, None);
+        let (verdict, event) = e.step(0, Some(&x), Some(-0.5));
         assert!(matches!(verdict, Estimated::Usable(..)));
         assert_eq!(event, None);
         // An orbit rate the drive does not admit: the estimate is lost, the next α restarts it.
-        let (_, event) = e.step(1, Some((0.5, 0.0, None)), None);
+        let (_, event) = e.step(1, Some(&sample(0.5, 100.0, None)), None);
         assert_eq!(event, Some(EventKind::EstimateLost));
         assert!(e.estimate().is_none());
     }
@@ -318,7 +444,7 @@ mod tests {
     #[test]
     fn the_drive_is_the_last_command_or_the_measured_mean_rate() {
         let cfg = estimator::Config::<f64>::paper();
-        let e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0)).unwrap();
+        let e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), None).unwrap();
         let orbit = OrbitTerms::circular(1.06e-3).unwrap();
         let c = Commanded {
             length_m: 100.0,
@@ -326,15 +452,15 @@ mod tests {
             accel_mps2: 0.1,
             mu3: 0.01,
         };
-        let d = e.drive(&c, orbit, 0, None);
+        let d = e.drive(&c, orbit, 0, None, 0.0);
         assert_eq!(
             (d.length_m, d.rate_mps, d.accel_mps2, d.mu3),
             (100.0, 2.0, 0.1, 0.01)
         );
         // The encoder's mean rate over the period is the drive's rate at mid-period.
-        let d = e.drive(&c, orbit, 0, Some(2.2));
+        let d = e.drive(&c, orbit, 0, Some(2.2), 0.0);
         assert_eq!(d.rate_mps + 0.5 * d.accel_mps2 * 1.0, 2.2);
         // The k-th period of a gap starts k periods of the command further on.
-        assert_eq!(e.drive(&c, orbit, 3, None).length_m, 106.0);
+        assert_eq!(e.drive(&c, orbit, 3, None, 0.0).length_m, 106.0);
     }
 }

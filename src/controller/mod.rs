@@ -293,7 +293,9 @@ impl<T: Real> Controller<T> {
         let spool_m = T::from_f64(cfg.envelope.max_length_m.to_f64() * (1.0 + SPOOL_MARGIN));
         let estimation = match &cfg.rate_source {
             RateSource::Sensor => None,
-            RateSource::Estimator(est) => Some(Estimation::new(est, &cfg.orbit)?),
+            RateSource::Estimator(est) => {
+                Some(Estimation::new(est, &cfg.orbit, cfg.tension_loop.as_ref())?)
+            }
         };
         let sequencer = Sequencer::new(&cfg);
         Ok(Self {
@@ -544,9 +546,7 @@ impl<T: Real> Controller<T> {
         let angles = match (&mut self.estimation, swing) {
             (None, Swing::Sensed(alpha_rad, alpha_rate_radps)) => Ok((alpha_rad, alpha_rate_radps)),
             (Some(est), Swing::Angle(alpha_rad)) => {
-                let orbit =
-                    accepted.map(|x| (x.orbit_rate_radps, x.true_anomaly_rad, x.reel_rate_mps));
-                let (verdict, event) = est.step(period.elapsed_ticks, orbit, alpha_rad);
+                let (verdict, event) = est.step(period.elapsed_ticks, accepted, alpha_rad);
                 self.events.record(period.tick, event);
                 match verdict {
                     Estimated::Usable(alpha_rad, alpha_rate_radps) => {
