@@ -2,7 +2,9 @@
 
 use crate::real::Real;
 
-use super::MAX_ALPHA_RATE_RADPS;
+/// The largest |α̇̂| a prediction may reach, rad/s (a thousand times the orbit rate; beyond it
+/// the estimate has diverged: [`Prediction::Diverged`](super::Prediction::Diverged)).
+pub const MAX_ALPHA_RATE_RADPS: f64 = 1.0;
 
 /// The estimator's parameters. Validated once by [`Estimator::new`](super::Estimator::new).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -3,7 +3,15 @@
 
 use crate::real::Real;
 
-use super::{above_or_nan, ROUNDING_LOAD};
+/// ε, the relative growth of each variance per period that stands for the rounding of the
+/// covariance propagation (see `Sym3::rounding_loaded`): 2⁻²², four f32 roundings.
+pub const ROUNDING_LOAD: f64 = 1.0 / 4_194_304.0;
+
+/// `v` above `cap`, or NaN: not `v ≤ cap`, in one comparison.
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN is meant to count as above
+pub(super) fn above_or_nan<T: Real>(v: T, cap: T) -> bool {
+    !(v <= cap)
+}
 
 /// A symmetric 3×3 matrix over (α, α̇, d), by its upper triangle.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -134,23 +134,16 @@ mod covariance;
 #[cfg(test)]
 mod tests;
 
-pub use config::{Config, ConfigError};
-use covariance::Sym3;
+pub use config::{Config, ConfigError, MAX_ALPHA_RATE_RADPS};
+pub use covariance::ROUNDING_LOAD;
+use covariance::{above_or_nan, Sym3};
 
 /// The largest |s h| = |(2 + μ3) l̇/l| h the one-step discretisation admits (see the module
 /// docs: the Taylor series of φ₁ is then accurate to 5·10⁻⁴). The paper's release is 0.2.
 pub const MAX_STRETCH_PER_PERIOD: f64 = 0.5;
 
-/// ε, the relative growth of each variance per period that stands for the rounding of the
-/// covariance propagation (see `Sym3::rounding_loaded`): 2⁻²², four f32 roundings.
-pub const ROUNDING_LOAD: f64 = 1.0 / 4_194_304.0;
-
 /// The cap on α's variance, rad² (1 rad of standard deviation: beyond it α̂ says nothing).
 pub const ALPHA_VARIANCE_CAP_RAD2: f64 = 1.0;
-
-/// The largest |α̇̂| a prediction may reach, rad/s (a thousand times the orbit rate; beyond it
-/// the estimate has diverged: [`Prediction::Diverged`]).
-pub const MAX_ALPHA_RATE_RADPS: f64 = 1.0;
 
 /// The largest orbit rate θ̇ a drive may give, rad/s (a 10⁻² rad/s orbit would be inside the
 /// Earth); its square bounds |θ̈| and μ/R³, which keeps 3(μ/R³)h² small for the discretisation.
@@ -683,12 +676,6 @@ impl<T: Real> Estimator<T> {
         t.trig = None;
         Measurement::Accepted(innovation)
     }
-}
-
-/// `v` above `cap`, or NaN: not `v ≤ cap`, in one comparison.
-#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN is meant to count as above
-fn above_or_nan<T: Real>(v: T, cap: T) -> bool {
-    !(v <= cap)
 }
 
 /// Which input of a refused drive is at fault (in the order of [`DriveInput`]), `u` = s h.

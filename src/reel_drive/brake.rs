@@ -1,6 +1,7 @@
 //! The brake (and motor enable) state machine of the speed loop.
 
-use super::{DriveFault, SpeedLoop};
+use super::config::BrakeConfig;
+use super::faults::DriveFault;
 
 /// The brake (and motor enable) state machine.
 ///
@@ -51,62 +52,57 @@ impl Brake {
     }
 }
 
-impl SpeedLoop {
-    /// Moves the brake to its next state. Entering `Released` starts the ramp from rest at
-    /// `tick` (the drum was held until now) and the observer of the implied tension; leaving
-    /// `Engaged` forgets where the brake held the drum. At rest means the command and the
-    /// measured speed ~0; a tick without a measured speed (`counted` false) neither advances
-    /// nor restarts the rest count. `tether_nm` is the torque of the tension the feed-forward
-    /// uses (T r).
-    pub(super) fn advance_brake(
-        &mut self,
-        tick: u32,
-        gap_ticks: u32,
-        speed_mps: f32,
-        counted: bool,
-        tether_nm: f32,
-    ) {
-        self.brake = match self.brake {
-            Brake::Tripped(_) | Brake::MotorHold => return,
-            Brake::Engaged if self.command_frees_brake && counted => {
-                self.checks.held_at_count = None;
-                Brake::Releasing {
-                    ticks_left: self.cfg.brake.release_ticks,
-                }
-            }
-            Brake::Engaged => return,
-            Brake::Releasing { .. } if !self.command_frees_brake => Brake::Engaged,
-            Brake::Releasing { ticks_left } if ticks_left <= gap_ticks => {
-                // The ramp is from rest: the brake was not free at the command.
-                self.ramp.start_tick = tick;
-                self.checks.start_observer(
-                    speed_mps,
-                    tether_nm,
-                    self.derived.observer_lag_mps_per_nm,
-                );
-                Brake::Released { rest_ticks: 0 }
-            }
-            Brake::Releasing { ticks_left } => Brake::Releasing {
-                ticks_left: ticks_left - gap_ticks,
+/// What the brake's state machine sees at a tick.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BrakeTick {
+    /// Ticks since the last step.
+    pub(super) gap_ticks: u32,
+    /// The drum's measured speed, m/s.
+    pub(super) speed_mps: f32,
+    /// The encoder was read at this tick (`speed_mps` is measured).
+    pub(super) counted: bool,
+    /// The command asks for motion.
+    pub(super) command_moving: bool,
+    /// The command lets the brake be free: moving, and not in safe hold.
+    pub(super) command_frees_brake: bool,
+}
+
+impl Brake {
+    /// The brake's next state. At rest means the command and the measured speed ~0; a tick
+    /// without a measured speed (`counted` false) neither advances nor restarts the rest
+    /// count. The speed loop acts on the transitions (leaving `Engaged`, entering `Released`);
+    /// `MotorHold` and `Tripped` are left only by the loop itself.
+    pub(super) fn next(self, x: &BrakeTick, cfg: &BrakeConfig) -> Self {
+        match self {
+            Self::Tripped(_) | Self::MotorHold => self,
+            Self::Engaged if x.command_frees_brake && x.counted => Self::Releasing {
+                ticks_left: cfg.release_ticks,
             },
-            Brake::Released { .. } if !counted => return,
-            Brake::Released { rest_ticks } => {
+            Self::Engaged => self,
+            Self::Releasing { .. } if !x.command_frees_brake => Self::Engaged,
+            Self::Releasing { ticks_left } if ticks_left <= x.gap_ticks => {
+                Self::Released { rest_ticks: 0 }
+            }
+            Self::Releasing { ticks_left } => Self::Releasing {
+                ticks_left: ticks_left - x.gap_ticks,
+            },
+            Self::Released { .. } if !x.counted => self,
+            Self::Released { rest_ticks } => {
                 // At rest: the command is rest and the drum is at rest (its reference, which
                 // it follows, is on its way there).
-                let at_rest =
-                    !self.command_moving && speed_mps.abs() <= self.cfg.brake.rest_speed_mps;
+                let at_rest = !x.command_moving && x.speed_mps.abs() <= cfg.rest_speed_mps;
                 if !at_rest {
-                    Brake::Released { rest_ticks: 0 }
+                    Self::Released { rest_ticks: 0 }
                 } else {
                     // (Cannot wrap: below `engage_ticks` ≤ 2³¹ − 1, plus a gap below 2³¹.)
-                    let rest_ticks = rest_ticks.wrapping_add(gap_ticks);
-                    if rest_ticks >= self.cfg.brake.engage_ticks {
-                        Brake::Engaged
+                    let rest_ticks = rest_ticks.wrapping_add(x.gap_ticks);
+                    if rest_ticks >= cfg.engage_ticks {
+                        Self::Engaged
                     } else {
-                        Brake::Released { rest_ticks }
+                        Self::Released { rest_ticks }
                     }
                 }
             }
-        };
+        }
     }
 }

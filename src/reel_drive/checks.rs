@@ -41,7 +41,7 @@
 //! of more than `brake_slip_m` from where the engaged brake first held it is a slipping brake,
 //! [`DriveFault::BrakeSlip`].
 
-use super::DriveFault;
+use super::faults::DriveFault;
 
 /// The state of the cross-checks.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -79,7 +79,8 @@ pub use encoder::{CountFault, Odometer};
 pub use faults::{DriveFault, DriveFaults, OuterReaction};
 
 use checks::{CrossChecks, TensionJudge};
-use reference::Ramp;
+use brake::BrakeTick;
+use reference::{Ramp, RampLimits};
 
 /// The rate command of one law period, as the inner loop needs it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -184,8 +185,8 @@ impl Drive {
 /// Constants derived once from the configuration, so that the step has no division.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Derived {
-    tick_s: f32,
-    outer_period_per_s: f32,
+    /// What shapes the reference's ramps.
+    ramp: RampLimits,
     /// ki × tick: the integral's growth per tick and m/s of error, N m.
     ki_tick: f32,
     /// J / r: inertia feed-forward per m/s².
@@ -261,8 +262,7 @@ impl SpeedLoop {
         let r = cfg.geometry.drum_radius_m;
         let f = &cfg.faults;
         let derived = Derived {
-            tick_s: cfg.tick_s(),
-            outer_period_per_s: cfg.inner_rate_hz as f32 / cfg.outer_period_ticks as f32,
+            ramp: RampLimits::new(&cfg),
             ki_tick: cfg.gains.ki_nm_per_m * cfg.tick_s(),
             inertia_per_radius: cfg.drum.inertia_kgm2 / r,
             viscous_per_radius: cfg.drum.viscous_nm_per_radps / r,
@@ -424,7 +424,7 @@ impl SpeedLoop {
         self.command_moving = self.command.rate_mps.abs() > self.cfg.brake.rest_speed_mps;
         self.command_frees_brake = self.command_moving && !self.command.safe_hold;
         let from_mps = match self.brake {
-            Brake::Released { .. } => self.reference_at(tick).0,
+            Brake::Released { .. } => self.ramp.at(tick).0,
             Brake::Engaged | Brake::Releasing { .. } | Brake::MotorHold | Brake::Tripped(_) => 0.0,
         };
         self.ramp = self.ramp_toward_command(from_mps, tick);
@@ -433,6 +433,12 @@ impl SpeedLoop {
         } else {
             Err(DriveFault::CommandInvalid)
         }
+    }
+
+    /// The ramp from `start_mps` at `tick` toward the command ([`Ramp::toward`]).
+    fn ramp_toward_command(&self, start_mps: f32, tick: u32) -> Ramp {
+        let c = &self.command;
+        Ramp::toward(c.rate_mps, c.accel_mps2, start_mps, tick, &self.derived.ramp)
     }
 
     /// Trips the drive for `fault` (motor off, brake on) — for faults found outside the step,
@@ -520,14 +526,37 @@ impl SpeedLoop {
         // judgement's).
         let tether_nm = tension_n * self.cfg.geometry.drum_radius_m;
 
-        self.advance_brake(tick, gap_ticks, speed_mps, counted, tether_nm);
+        // The brake's next state; leaving `Engaged` forgets where it held the drum, entering
+        // `Released` starts the ramp from rest at this tick (the drum was held until now) and
+        // the observer of the implied tension.
+        let brake_tick = BrakeTick {
+            gap_ticks,
+            speed_mps,
+            counted,
+            command_moving: self.command_moving,
+            command_frees_brake: self.command_frees_brake,
+        };
+        let before = self.brake;
+        self.brake = before.next(&brake_tick, &self.cfg.brake);
+        match (before, self.brake) {
+            (Brake::Engaged, Brake::Releasing { .. }) => self.checks.held_at_count = None,
+            (Brake::Releasing { .. }, Brake::Released { .. }) => {
+                self.ramp.start_tick = tick;
+                self.checks.start_observer(
+                    speed_mps,
+                    tether_nm,
+                    self.derived.observer_lag_mps_per_nm,
+                );
+            }
+            _ => {}
+        }
 
         // The torque: PI + feed-forward with the brake free (toward rest while the motor holds
         // a slipping brake), with the checks of a driven drum; while it lifts, the motor takes
         // over the tension's torque, nothing else; otherwise the motor is off.
         let drive = match self.brake {
             Brake::Released { rest_ticks } => {
-                let (ref_mps, ref_accel_mps2) = self.reference_at(tick);
+                let (ref_mps, ref_accel_mps2) = self.ramp.at(tick);
                 self.reference = (ref_mps, ref_accel_mps2);
                 let torque_nm =
                     self.speed_law(ref_mps, ref_accel_mps2, gap_ticks, speed_mps, tether_nm);

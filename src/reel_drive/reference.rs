@@ -1,7 +1,34 @@
 //! The speed loop's reference: a ramp toward the commanded rate (module docs of
 //! [`super`], step 2).
 
-use super::{saturate, SpeedLoop};
+use super::config::DriveConfig;
+
+/// What shapes every ramp, worked out once from the configuration (so that the ramp has no
+/// division but the one of its length).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct RampLimits {
+    /// The inner ticks per second, 1/s.
+    ticks_per_s: f32,
+    /// The inner tick, s.
+    tick_s: f32,
+    /// Law periods per second: the slope that reaches a command within one period is its
+    /// change times this, 1/s.
+    outer_period_per_s: f32,
+    /// The steepest slope, m/s².
+    max_accel_mps2: f32,
+}
+
+impl RampLimits {
+    /// The limits of a validated configuration.
+    pub(super) fn new(cfg: &DriveConfig) -> Self {
+        Self {
+            ticks_per_s: cfg.inner_rate_hz as f32,
+            tick_s: cfg.tick_s(),
+            outer_period_per_s: cfg.inner_rate_hz as f32 / cfg.outer_period_ticks as f32,
+            max_accel_mps2: cfg.max_accel_mps2,
+        }
+    }
+}
 
 /// The ramp the reference follows toward the commanded rate.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -30,33 +57,41 @@ impl Ramp {
         step_mps: 0.0,
         ramp_ticks: 0,
     };
-}
 
-impl SpeedLoop {
-    /// The ramp from `start_mps` at `tick` toward the command: its slope is the command's
-    /// (Eq. 30) acceleration if that points toward the command, at least what reaches the
-    /// command within one law period, at most `max_accel_mps2`.
-    pub(super) fn ramp_toward_command(&self, start_mps: f32, tick: u32) -> Ramp {
-        let target = self.command.rate_mps;
-        let dv = target - start_mps;
-        let law = if self.command.accel_mps2 * dv > 0.0 {
-            self.command.accel_mps2.abs()
+    /// The ramp from `start_mps` at `tick` toward the commanded rate `target_mps` (finite):
+    /// its slope is the command's (Eq. 30) acceleration `accel_mps2` if that points toward the
+    /// target, at least what reaches the target within one law period, at most the limits'
+    /// steepest.
+    pub(super) fn toward(
+        target_mps: f32,
+        accel_mps2: f32,
+        start_mps: f32,
+        tick: u32,
+        limits: &RampLimits,
+    ) -> Self {
+        let dv = target_mps - start_mps;
+        let law = if accel_mps2 * dv > 0.0 {
+            accel_mps2.abs()
         } else {
             0.0
         };
-        let per_period = dv.abs() * self.derived.outer_period_per_s;
+        let per_period = dv.abs() * limits.outer_period_per_s;
         let fastest = if law > per_period { law } else { per_period };
-        let magnitude = saturate(fastest, self.cfg.max_accel_mps2).0;
+        let magnitude = if fastest > limits.max_accel_mps2 {
+            limits.max_accel_mps2
+        } else {
+            fastest
+        };
         // Whole ticks to the target, rounded up (`as` saturates; 0 when already there).
-        let ticks = dv.abs() / magnitude * self.cfg.inner_rate_hz as f32;
+        let ticks = dv.abs() / magnitude * limits.ticks_per_s;
         let whole = ticks as u32;
         let slope_mps2 = magnitude.copysign(dv);
-        Ramp {
+        Self {
             start_mps,
             start_tick: tick,
-            target_mps: target,
+            target_mps,
             slope_mps2,
-            step_mps: slope_mps2 * self.derived.tick_s,
+            step_mps: slope_mps2 * limits.tick_s,
             ramp_ticks: if (whole as f32) < ticks {
                 whole.saturating_add(1)
             } else {
@@ -67,13 +102,15 @@ impl SpeedLoop {
 
     /// The reference speed and acceleration at `tick`: the ramp, stopped at its target. (Only
     /// used while the brake is free; the ramp restarts from rest when it is released.)
-    pub(super) fn reference_at(&self, tick: u32) -> (f32, f32) {
-        let r = &self.ramp;
-        let age_ticks = tick.wrapping_sub(r.start_tick);
-        if age_ticks >= r.ramp_ticks {
-            (r.target_mps, 0.0)
+    pub(super) fn at(&self, tick: u32) -> (f32, f32) {
+        let age_ticks = tick.wrapping_sub(self.start_tick);
+        if age_ticks >= self.ramp_ticks {
+            (self.target_mps, 0.0)
         } else {
-            (r.start_mps + r.step_mps * age_ticks as f32, r.slope_mps2)
+            (
+                self.start_mps + self.step_mps * age_ticks as f32,
+                self.slope_mps2,
+            )
         }
     }
 }
@@ -95,14 +132,14 @@ mod tests {
         let mut s = SpeedLoop::new(DriveConfig::example()).unwrap();
         // A limited command: 1 m/s reached at 1 m/s² (Eq. 30 value = the ramp's slope).
         s.set_command(command(1.0, 1.0), 0).unwrap();
-        assert_eq!(s.reference_at(500), (0.5, 1.0));
-        assert_eq!(s.reference_at(1000), (1.0, 0.0));
-        assert_eq!(s.reference_at(5000), (1.0, 0.0));
+        assert_eq!(s.ramp.at(500), (0.5, 1.0));
+        assert_eq!(s.ramp.at(1000), (1.0, 0.0));
+        assert_eq!(s.ramp.at(5000), (1.0, 0.0));
         // With the brake free, the next command ramps from the reference; an acceleration
         // pointing away from the command does not move the reference away.
         s.brake = Brake::Released { rest_ticks: 0 };
         s.set_command(command(0.5, 2.0), 1000).unwrap();
-        let (v, a) = s.reference_at(1500);
+        let (v, a) = s.ramp.at(1500);
         assert!((v - 0.75).abs() < 1e-6 && a == -0.5, "{v} {a}");
     }
 
