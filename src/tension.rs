@@ -44,10 +44,39 @@ pub fn admittance_gain_mps_per_n<T: Real>(
     damping_ratio: T,
     period_s: T,
 ) -> T {
-    let two = T::from_f64(2.0);
-    let designed = two * damping_ratio * (length_m / (stiffness_n * radial_kg)).sqrt();
-    let cap = T::from_f64(MAX_GAIN_PERIOD_PRODUCT) * length_m / (stiffness_n * period_s);
-    designed.min(cap).max(T::ZERO)
+    AdmittanceGain::new(stiffness_n, radial_kg, damping_ratio, period_s).at(length_m)
+}
+
+/// K(l) of (17.5)–(17.6) for one tether, reduced mass, damping ratio and period: the parts that
+/// do not depend on the length, worked out once ([`admittance_gain_mps_per_n`] at any length).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdmittanceGain<T> {
+    /// 2 ζ_d.
+    two_damping_ratio: T,
+    /// EA m_r, N kg.
+    stiffness_mass_n_kg: T,
+    /// EA Δt, N s.
+    stiffness_period_n_s: T,
+}
+
+impl<T: Real> AdmittanceGain<T> {
+    /// The gain of a tether of axial stiffness `stiffness_n` (EA, N) with the reduced mass
+    /// `radial_kg`, the damping ratio `damping_ratio` and the control period `period_s`.
+    pub fn new(stiffness_n: T, radial_kg: T, damping_ratio: T, period_s: T) -> Self {
+        Self {
+            two_damping_ratio: T::from_f64(2.0) * damping_ratio,
+            stiffness_mass_n_kg: stiffness_n * radial_kg,
+            stiffness_period_n_s: stiffness_n * period_s,
+        }
+    }
+
+    /// K at the unstretched length `length_m`, m/s per N: 2 ζ_d √(l/(EA m_r)), at most
+    /// g_max l/(EA Δt), never negative.
+    pub fn at(&self, length_m: T) -> T {
+        let designed = self.two_damping_ratio * (length_m / self.stiffness_mass_n_kg).sqrt();
+        let cap = T::from_f64(MAX_GAIN_PERIOD_PRODUCT) * length_m / self.stiffness_period_n_s;
+        designed.min(cap).max(T::ZERO)
+    }
 }
 
 /// The weight β = 1 − e^{−Δt/τ_w} of a new sample in the washout's mean (17.3).
@@ -109,18 +138,77 @@ pub fn tension_window_mps2<T: Real>(
     overshoot: T,
     inv_radial_per_kg: T,
 ) -> (T, T) {
-    let per_n = inv_radial_per_kg / overshoot;
-    let floor_n = min_tension_n.min(T::from_f64(FLOOR_SHARE_OF_MEAN) * low_free_n);
-    let hi = (low_free_n - floor_n) * per_n;
-    let lo = (high_free_n - max_tension_n) * per_n;
-    (lo.min(T::ZERO), hi.max(T::ZERO))
+    TensionWindow::new(min_tension_n, max_tension_n, overshoot, inv_radial_per_kg)
+        .of(low_free_n, high_free_n)
+}
+
+/// The tension window of (17.8) for one band, overshoot allowance and reduced mass, worked
+/// out once ([`tension_window_mps2`] of any free tension).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TensionWindow<T> {
+    /// T_lo before the floor's share of the mean, N.
+    min_tension_n: T,
+    /// T_hi, N.
+    max_tension_n: T,
+    /// 1/(κ m_r): the acceleration per newton of margin, m/s² per N.
+    accel_per_n: T,
+}
+
+impl<T: Real> TensionWindow<T> {
+    /// The window of the band [`min_tension_n`, `max_tension_n`] with the elastic overshoot
+    /// allowance `overshoot` (κ ≥ 1), at the reduced mass whose reciprocal is
+    /// `inv_radial_per_kg`.
+    pub fn new(min_tension_n: T, max_tension_n: T, overshoot: T, inv_radial_per_kg: T) -> Self {
+        Self {
+            min_tension_n,
+            max_tension_n,
+            accel_per_n: inv_radial_per_kg / overshoot,
+        }
+    }
+
+    /// [a_lo, a_hi], m/s², from the lower and the higher estimate of the free tension
+    /// (`low_free_n`, `high_free_n`, N): see [`tension_window_mps2`].
+    pub fn of(&self, low_free_n: T, high_free_n: T) -> (T, T) {
+        let per_n = self.accel_per_n;
+        let floor_n = self
+            .min_tension_n
+            .min(T::from_f64(FLOOR_SHARE_OF_MEAN) * low_free_n);
+        let hi = (low_free_n - floor_n) * per_n;
+        let lo = (high_free_n - self.max_tension_n) * per_n;
+        (lo.min(T::ZERO), hi.max(T::ZERO))
+    }
 }
 
 /// The attitude's share w ∈ [0, 1] of the authority over the command (docs/equations.md §17.5):
 /// 0 while |δ| ≤ `from_rad`, 1 from `full_rad` on, linear between. The tension window is widened
 /// to the envelope's by w.
 pub fn attitude_share<T: Real>(delta_rad: T, from_rad: T, full_rad: T) -> T {
-    ((delta_rad.abs() - from_rad) / (full_rad - from_rad)).clamp_to(T::ZERO, T::ONE)
+    AttitudeShare::new(from_rad, full_rad).at(delta_rad)
+}
+
+/// The attitude's share of (§17.5) for one yield band, worked out once ([`attitude_share`] of
+/// any δ).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AttitudeShare<T> {
+    /// |δ| where the share begins, rad.
+    from_rad: T,
+    /// The band's width, rad (the share is 1 at its end).
+    width_rad: T,
+}
+
+impl<T: Real> AttitudeShare<T> {
+    /// The share that is 0 while |δ| ≤ `from_rad` and 1 from `full_rad` on.
+    pub fn new(from_rad: T, full_rad: T) -> Self {
+        Self {
+            from_rad,
+            width_rad: full_rad - from_rad,
+        }
+    }
+
+    /// w at the attitude error `delta_rad` (0 for NaN).
+    pub fn at(&self, delta_rad: T) -> T {
+        ((delta_rad.abs() - self.from_rad) / self.width_rad).clamp_to(T::ZERO, T::ONE)
+    }
 }
 
 #[cfg(test)]

@@ -14,9 +14,7 @@
 use crate::config::TensionLoopConfig;
 use crate::mass::MassModel;
 use crate::real::Real;
-use crate::tension::{
-    admittance_gain_mps_per_n, attitude_share, tension_window_mps2, washout_weight, Washout,
-};
+use crate::tension::{washout_weight, AdmittanceGain, AttitudeShare, TensionWindow, Washout};
 
 use crate::config::MAX_PLAUSIBLE_TENSION_N;
 use crate::envelope::Bounds;
@@ -92,14 +90,45 @@ pub(crate) struct StageOutput<T> {
     pub(crate) mode_changed: Option<TensionLoopMode>,
 }
 
+/// What the loop's laws take of the reduced mass m_r: m_r itself, the tension window (17.8)
+/// and the admittance gain (17.5)–(17.6) at it.
+#[derive(Clone, Copy, Debug)]
+struct AtMass<T> {
+    radial_kg: T,
+    window: TensionWindow<T>,
+    gain: AdmittanceGain<T>,
+}
+
+impl<T: Real> AtMass<T> {
+    fn new(cfg: &TensionLoopConfig<T>, radial_kg: T, period_s: T) -> Self {
+        Self {
+            radial_kg,
+            window: TensionWindow::new(
+                cfg.min_tension_n,
+                cfg.max_tension_n,
+                cfg.overshoot,
+                T::ONE / radial_kg,
+            ),
+            gain: AdmittanceGain::new(
+                cfg.axial_stiffness_n,
+                radial_kg,
+                cfg.damping_ratio,
+                period_s,
+            ),
+        }
+    }
+}
+
 /// The tension loop's state.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct TensionStage<T> {
     cfg: TensionLoopConfig<T>,
     masses: MassModel<T>,
-    /// m_r and 1/m_r at zero length (those of every length for a massless tether), kg and 1/kg.
-    radial_kg: T,
-    inv_radial_per_kg: T,
+    /// The laws at m_r of a massless tether (that of every length), worked out once; `None`
+    /// for a tether with mass (m_r of each step's length).
+    fixed_mass: Option<AtMass<T>>,
+    /// The attitude's share of the authority (§17.5) over the configured yield band.
+    share: AttitudeShare<T>,
     /// β of the washout (17.3).
     washout_weight: T,
     /// The envelope's acceleration limit, m/s² (the window's width at full attitude share).
@@ -125,12 +154,13 @@ impl<T: Real> TensionStage<T> {
         period_s: T,
         envelope_accel_mps2: T,
     ) -> Self {
-        let radial_kg = masses.coefficients(T::ZERO).radial_kg;
+        let fixed_mass = (masses.tether_density_kg_per_m == T::ZERO)
+            .then(|| AtMass::new(&cfg, masses.coefficients(T::ZERO).radial_kg, period_s));
         Self {
             cfg,
             masses,
-            radial_kg,
-            inv_radial_per_kg: T::ONE / radial_kg,
+            fixed_mass,
+            share: AttitudeShare::new(cfg.yield_from_rad, cfg.yield_full_rad),
             washout_weight: washout_weight(cfg.washout_s, period_s),
             envelope_accel_mps2,
             period_s,
@@ -179,12 +209,15 @@ impl<T: Real> TensionStage<T> {
     /// One step of the law: the command to request of the envelope.
     pub(crate) fn step(&mut self, x: &StageInput<T>) -> StageOutput<T> {
         let dt = self.period_s;
-        let (radial_kg, inv_radial_per_kg) = if self.masses.tether_density_kg_per_m == T::ZERO {
-            (self.radial_kg, self.inv_radial_per_kg)
-        } else {
-            let m = self.masses.coefficients(x.length_m).radial_kg;
-            (m, T::ONE / m)
+        let at_mass = match self.fixed_mass {
+            Some(m) => m,
+            None => AtMass::new(
+                &self.cfg,
+                self.masses.coefficients(x.length_m).radial_kg,
+                dt,
+            ),
         };
+        let radial_kg = at_mass.radial_kg;
         let before = self.load_cell.mode();
 
         // The load cell: the free tension it measures (17.3), its mean and its bounce.
@@ -231,17 +264,13 @@ impl<T: Real> TensionStage<T> {
         let (a_lo, a_hi) = match &self.load_cell {
             // Judged on the mean and on this period's free tension, whichever is the worse for
             // the motion (the mean lags a free tension that changes, as in the slew).
-            LoadCell::Tracking(w) | LoadCell::Coasting { washout: w, .. } => tension_window_mps2(
+            LoadCell::Tracking(w) | LoadCell::Coasting { washout: w, .. } => at_mass.window.of(
                 w.mean_n + bounce_n.min(T::ZERO),
                 w.mean_n + bounce_n.max(T::ZERO),
-                c.min_tension_n,
-                c.max_tension_n,
-                c.overshoot,
-                inv_radial_per_kg,
             ),
             LoadCell::Waiting | LoadCell::Lost => (-c.fallback_accel_mps2, c.fallback_accel_mps2),
         };
-        let share = attitude_share(x.delta_rad, c.yield_from_rad, c.yield_full_rad);
+        let share = self.share.at(x.delta_rad);
         self.attitude_share = share;
         let a_env = self.envelope_accel_mps2;
         let a_hi = a_hi + share * (a_env - a_hi).max(T::ZERO);
@@ -255,13 +284,7 @@ impl<T: Real> TensionStage<T> {
         self.last_shaped_accel_mps2 = (shaped_mps - anchor_mps) / dt;
 
         // The admittance term (17.3), K(l) of (17.5)–(17.6).
-        let gain = admittance_gain_mps_per_n(
-            x.length_m,
-            c.axial_stiffness_n,
-            radial_kg,
-            c.damping_ratio,
-            dt,
-        );
+        let gain = at_mass.gain.at(x.length_m);
         let admittance_mps = gain * bounce_n;
         let rate_mps = shaped_mps + admittance_mps;
         let accel_mps2 = if shaped {
@@ -284,6 +307,7 @@ impl<T: Real> TensionStage<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::tension::admittance_gain_mps_per_n;
 
     fn stage() -> TensionStage<f64> {
         TensionStage::new(

@@ -67,26 +67,39 @@ pub(super) struct BrakeTick {
     pub(super) command_frees_brake: bool,
 }
 
+/// A transition of the brake that the speed loop acts on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum BrakeEdge {
+    /// `Engaged` left for `Releasing`: where the brake held the drum is forgotten.
+    Lifting,
+    /// `Releasing` left for `Released`: the drum is free from this tick on.
+    Freed,
+}
+
 impl Brake {
-    /// The brake's next state. At rest means the command and the measured speed ~0; a tick
-    /// without a measured speed (`counted` false) neither advances nor restarts the rest
-    /// count. The speed loop acts on the transitions (leaving `Engaged`, entering `Released`);
-    /// `MotorHold` and `Tripped` are left only by the loop itself.
-    pub(super) fn next(self, x: &BrakeTick, cfg: &BrakeConfig) -> Self {
-        match self {
-            Self::Tripped(_) | Self::MotorHold => self,
-            Self::Engaged if x.command_frees_brake && x.counted => Self::Releasing {
-                ticks_left: cfg.release_ticks,
-            },
-            Self::Engaged => self,
+    /// Moves the brake to its next state; returns the transition the speed loop acts on, if
+    /// any. At rest means the command and the measured speed ~0; a tick without a measured
+    /// speed (`counted` false) neither advances nor restarts the rest count. `MotorHold` and
+    /// `Tripped` are left only by the loop itself.
+    pub(super) fn advance(&mut self, x: &BrakeTick, cfg: &BrakeConfig) -> Option<BrakeEdge> {
+        *self = match *self {
+            Self::Tripped(_) | Self::MotorHold => return None,
+            Self::Engaged if x.command_frees_brake && x.counted => {
+                *self = Self::Releasing {
+                    ticks_left: cfg.release_ticks,
+                };
+                return Some(BrakeEdge::Lifting);
+            }
+            Self::Engaged => return None,
             Self::Releasing { .. } if !x.command_frees_brake => Self::Engaged,
             Self::Releasing { ticks_left } if ticks_left <= x.gap_ticks => {
-                Self::Released { rest_ticks: 0 }
+                *self = Self::Released { rest_ticks: 0 };
+                return Some(BrakeEdge::Freed);
             }
             Self::Releasing { ticks_left } => Self::Releasing {
                 ticks_left: ticks_left - x.gap_ticks,
             },
-            Self::Released { .. } if !x.counted => self,
+            Self::Released { .. } if !x.counted => return None,
             Self::Released { rest_ticks } => {
                 // At rest: the command is rest and the drum is at rest (its reference, which
                 // it follows, is on its way there).
@@ -103,6 +116,7 @@ impl Brake {
                     }
                 }
             }
-        }
+        };
+        None
     }
 }

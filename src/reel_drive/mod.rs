@@ -78,8 +78,8 @@ pub use config::{
 pub use encoder::{CountFault, Odometer};
 pub use faults::{DriveFault, DriveFaults, OuterReaction};
 
+use brake::{BrakeEdge, BrakeTick};
 use checks::{CrossChecks, TensionJudge};
-use brake::BrakeTick;
 use reference::{Ramp, RampLimits};
 
 /// The rate command of one law period, as the inner loop needs it.
@@ -438,7 +438,13 @@ impl SpeedLoop {
     /// The ramp from `start_mps` at `tick` toward the command ([`Ramp::toward`]).
     fn ramp_toward_command(&self, start_mps: f32, tick: u32) -> Ramp {
         let c = &self.command;
-        Ramp::toward(c.rate_mps, c.accel_mps2, start_mps, tick, &self.derived.ramp)
+        Ramp::toward(
+            c.rate_mps,
+            c.accel_mps2,
+            start_mps,
+            tick,
+            &self.derived.ramp,
+        )
     }
 
     /// Trips the drive for `fault` (motor off, brake on) — for faults found outside the step,
@@ -536,11 +542,9 @@ impl SpeedLoop {
             command_moving: self.command_moving,
             command_frees_brake: self.command_frees_brake,
         };
-        let before = self.brake;
-        self.brake = before.next(&brake_tick, &self.cfg.brake);
-        match (before, self.brake) {
-            (Brake::Engaged, Brake::Releasing { .. }) => self.checks.held_at_count = None,
-            (Brake::Releasing { .. }, Brake::Released { .. }) => {
+        match self.brake.advance(&brake_tick, &self.cfg.brake) {
+            Some(BrakeEdge::Lifting) => self.checks.held_at_count = None,
+            Some(BrakeEdge::Freed) => {
                 self.ramp.start_tick = tick;
                 self.checks.start_observer(
                     speed_mps,
@@ -548,7 +552,7 @@ impl SpeedLoop {
                     self.derived.observer_lag_mps_per_nm,
                 );
             }
-            _ => {}
+            None => {}
         }
 
         // The torque: PI + feed-forward with the brake free (toward rest while the motor holds
