@@ -221,10 +221,9 @@ impl<T: Real> TensionStage<T> {
         let before = self.load_cell.mode();
 
         // The load cell: the free tension it measures (17.3), its mean and its bounce.
+        // (One comparison: false for NaN and the infinities too.)
         let plausible = T::from_f64(MAX_PLAUSIBLE_TENSION_N);
-        let sample = x
-            .tension_n
-            .filter(|t| t.is_finite() && t.abs() <= plausible);
+        let sample = x.tension_n.filter(|t| t.abs() <= plausible);
         let bounce_n = match (sample, &mut self.load_cell) {
             (Some(t), LoadCell::Tracking(w) | LoadCell::Coasting { washout: w, .. }) => {
                 let mut w = *w;
