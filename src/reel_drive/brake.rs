@@ -31,7 +31,7 @@ pub enum Brake {
     },
     /// The engaged brake slipped ([`DriveFault::BrakeSlip`]): it stays applied, and the motor
     /// holds the drum at rest with the speed loop (reference 0), whatever the command, until
-    /// [`SpeedLoop::clear_trip`].
+    /// [`SpeedLoop::clear_trip`](crate::reel_drive::SpeedLoop::clear_trip).
     MotorHold,
     /// A fault left the drum uncontrolled: brake on, motor off, until cleared.
     Tripped(DriveFault),
