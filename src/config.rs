@@ -280,7 +280,7 @@ pub enum RateSource<T> {
     /// without α or α̇ is a bad sample.
     Sensor,
     /// The onboard estimator ([`crate::estimator`]) on the sensed α alone: what flies, since
-    /// no flight sensor measures α̇ (issue 18).
+    /// no flight sensor measures α̇.
     Estimator(estimator::Config<T>),
 }
 

@@ -1,4 +1,4 @@
-//! The sensors as they fly (issue 18): what the reel MCU reads each control period, modelled in
+//! The sensors as they fly: what the reel MCU reads each control period, modelled in
 //! f64 between the plant's truth and the controller.
 //!
 //! - [`SwingSensor`]: α from a deployer angle sensor or relative navigation: bias, noise,

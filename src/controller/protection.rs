@@ -1,4 +1,4 @@
-//! Tension- and drive-aware protection (issue 18; docs/equations.md §14): the command is
+//! Tension- and drive-aware protection (docs/equations.md §14): the command is
 //! bounded by what the tether carries and by what a lagging drive will actually do.
 //!
 //! **The tension bound.** Eq. 5a with the reel's acceleration l̈ split out,

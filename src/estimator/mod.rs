@@ -1,6 +1,6 @@
 //! The onboard libration estimator: an extended Kalman filter on the in-plane dynamics
 //! (Eq. 5b / 26 with β = 0) that estimates α and α̇ from a swing-angle sensor that measures α
-//! only (issue 18: no flight sensor measures α̇).
+//! only (no flight sensor measures α̇).
 //!
 //! # Model
 //!
@@ -63,7 +63,7 @@
 //!
 //! # Tuning ([`Config::paper`]) and the noise it assumes
 //!
-//! - α noise σ_α = 1e-4 rad per sample (issue 18's floor), not quantised (a quantum q adds
+//! - α noise σ_α = 1e-4 rad per sample (the flight sensor's floor), not quantised (a quantum q adds
 //!   q²/12 to R).
 //! - d drifts as a random walk of density 1e-11 rad/s² per √s: it spans 4e-10 rad/s² in a
 //!   quarter orbit and 3e-9 rad/s² in a day. That covers, as slowly varying accelerations, a

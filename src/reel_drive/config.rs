@@ -10,7 +10,7 @@ use core::f32::consts::PI;
 /// The longest speed window [`DriveConfig::speed_window_ticks`] may ask for, ticks.
 pub const SPEED_WINDOW_CAPACITY: usize = 8;
 
-/// The slowest inner loop allowed, Hz (issue 19: "at least 100 Hz").
+/// The slowest inner loop allowed, Hz.
 pub const MIN_INNER_RATE_HZ: u32 = 100;
 
 /// The longest tick count a threshold of the step's counters may ask for

@@ -1,4 +1,4 @@
-//! The reel's inner speed loop: the drum follows the outer law's rate command (issue 19).
+//! The reel's inner speed loop: the drum follows the outer law's rate command.
 //!
 //! The outer controller ([`crate::controller`]) commands a reel rate l̇_real and its
 //! acceleration (Eq. 30) once a law period (1 s). The reel-mechanism MCU turns that into motor

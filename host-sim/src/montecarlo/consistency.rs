@@ -1,4 +1,4 @@
-//! The libration estimator's consistency over a campaign (issue 18): NEES and NIS averaged over
+//! The libration estimator's consistency over a campaign: NEES and NIS averaged over
 //! the runs, against their χ² bounds (`tss-sim montecarlo --consistency`).
 //!
 //! A filter is consistent when its errors are as large as its covariance says (Bar-Shalom, Li &

@@ -4,7 +4,7 @@
 //!
 //! Every error defaults to zero: a section left out is an ideal sensor (the paper's
 //! idealisation, which `scenarios/paper.toml` flies), except that the α̇ rate sensor is off
-//! unless `sensors.alpha_rate.enabled = true` (no flight sensor measures α̇: issue 18).
+//! unless `sensors.alpha_rate.enabled = true` (no flight sensor measures α̇).
 //! Realistic figures, and what each stands for, are in the README's sensor table and in
 //! `scenarios/paper-montecarlo.toml`.
 
