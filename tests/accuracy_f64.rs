@@ -32,7 +32,7 @@ use tss_reel::recordings::{mission, replay as replay_data};
 /// Commands slower than this are compared against it instead of their own size, m/s.
 const RATE_FLOOR_MPS: f64 = 1e-3;
 
-/// The accuracy goal of issue 7: f32 within 1e-5 of f64 (relative, as defined above).
+/// The accuracy goal: f32 within 1e-5 of f64 (relative, as defined above).
 const GOAL: f64 = 1e-5;
 
 /// An error above the goal counts as explained by the inputs' precision when it is within this
@@ -244,7 +244,7 @@ fn firmware_replay_f32_vs_f64() {
     // Deployment below 26 km: the goal holds at every step of the law (measured: max 5.3e-7).
     let law_max = f.rels.last().copied().unwrap_or(0.0);
     assert!(law_max <= GOAL / 10.0, "law steps: max {law_max:e}");
-    // The safe hold's ramp (0.01 m/s², no longer one step to zero) carries the last law
+    // The safe hold's ramp (0.01 m/s², not one step to zero) carries the last law
     // command's absolute rounding (≈ 1e-8 m/s) down toward zero, where it is a larger share
     // of a smaller command: measured 1.05e-6 at tick 430 (9.5 mm/s, |Δy| = 1.0e-8 m/s).
     assert!(f.worst.rel <= 2.0 * GOAL / 10.0, "{:?}", f.worst);
@@ -261,12 +261,12 @@ fn whole_mission_f32_vs_f64() {
     // in the stage-1 keep, at the turning points of its first swing (31.3 km and 29.6 km, the
     // command a few mm/s) where that effect reaches 5.7e-5; the largest difference 1.8e-7
     // m/s). There one f32 ulp of sin 2α moves the command as much as α's rounding does: the
-    // max was 3.6e-5 with the earlier polynomial sine, 1.02e-4 with the table sine (both
-    // within their 1.5 to 2.5e-7 bounds), so the cap below is 2e-4, and every step above the
-    // goal is still within 4× the input-rounding effect. Two earlier f32 losses are gone and
-    // stay gone: the quintic transitions are evaluated from the nearer band end (2.6e-2 at
-    // the keeps), and 1 − E of the blend is computed as −expm1(−cτ), not from the rounded E
-    // (5.8e-5 right after the stage-2 restart, E ≈ 1).
+    // max is 1.02e-4 with the table sine (3.6e-5 with a polynomial sine; both within their 1.5
+    // to 2.5e-7 bounds), so the cap below is 2e-4, and every step above the goal is still
+    // within 4× the input-rounding effect. Two other f32 losses are kept out: the quintic
+    // transitions are evaluated from the nearer band end (from the far end, 2.6e-2 at the
+    // keeps), and 1 − E of the blend is computed as −expm1(−cτ), not from the rounded E
+    // (which gives 5.8e-5 right after the stage-2 restart, E ≈ 1).
     assert_eq!(f.unexplained, 0, "{:?}", f.worst);
     assert!(f.worst.rel <= 2e-4, "{:?}", f.worst);
     assert!(f.worst.abs_mps <= 1e-6, "{:?}", f.worst);

@@ -1,8 +1,8 @@
-//! Closed-loop fault scenarios (issue 5): the flight controller core (f32) flying the tss-sim
-//! plant with faults injected between them (`tss_sim::faults`) and a non-ideal reel
-//! (`tss_sim::reel`). Each test states the fault, the expected detection and safe action, and
-//! asserts the outcome with a bound that was measured (the measured value is in the comment)
-//! and given a margin. Every number here is in `docs/hazards.md`.
+//! Closed-loop fault scenarios: the flight controller core (f32) flying the tss-sim plant with
+//! faults injected between them (`tss_sim::faults`) and a non-ideal reel (`tss_sim::reel`). Each
+//! test states the fault, the expected detection and safe action, and asserts the outcome with a
+//! bound that was measured (the measured value is in the comment) and given a margin. Every
+//! number here is in `docs/hazards.md`.
 //!
 //! Runs are shortened (`simulation.duration_s`) where the full 20 h mission is not needed.
 
@@ -107,7 +107,7 @@ fn dropout_of_60_s_in_deployment_coasts_holds_recovers_and_keeps_30_km() {
     assert_eq!(ticks_of(f, Fault::Sensor(Sensor::Missing)), 60);
     assert_eq!(f.faults.len(), 1, "only the dropout: {:?}", f.faults);
     assert_eq!((f.degraded_s, f.safe_hold_s), (30.0, 39.0));
-    // In safe hold the rate ramps to zero at the safe hold's 0.01 m/s² (no longer the paper
+    // In safe hold the rate ramps to zero at the safe hold's 0.01 m/s² (not the paper
     // envelope's 15 m/s², one tick to stop): 0.1 m/s less in the 10 s from 5030 s to 5040 s.
     let (r30, r40) = (
         at(&h, 5030.0).length_rate_mps,
@@ -676,7 +676,7 @@ fn spool_end_holds_with_a_lagging_drive() {
         );
         assert_envelope(f, 0.0);
     }
-    // Without the protection the same drive passes the spool end (the hazard as it was): the
+    // Without the protection the same drive passes the spool end (the hazard itself): the
     // simulator stops the run where the tether leaves the spool.
     let h = run(
         REEL_LIMITS,
@@ -792,10 +792,10 @@ fn the_protection_keeps_the_tension_margin_from_release() {
     assert!((at_8h.1 - 30_000.0).abs() < 0.01, "{at_8h:?}");
 }
 
-/// O-6: the disturbances that slackened the unprotected start no longer do. A 1° α bias
-/// (was slack 866–1284 s; the biased model is corrected by the load cell over τ_f, measured
-/// min 1.77 mN, 88 % of the margin) and a 2 s reel lag (was slack 983–1268 s; measured min 2.0 mN from the first
-/// tension sample on).
+/// O-6: the disturbances that slacken an unprotected start leave the protected one taut. A 1° α
+/// bias (unprotected, slack 866–1284 s; the biased model is corrected by the load cell over
+/// τ_f, measured min 1.77 mN, 88 % of the margin) and a 2 s reel lag (unprotected, slack
+/// 983–1268 s; measured min 2.0 mN from the first tension sample on).
 #[test]
 fn the_protected_start_does_not_slacken_under_bias_or_lag() {
     let bias = format!("sensors.alpha.bias={}", 1f64.to_radians());
@@ -898,7 +898,7 @@ fn the_fault_summary_text_reports_faults_and_slack() {
         "nominal → degraded",
         "degraded → safe hold",
         "safe hold 19 s",
-        // (The safe hold ramps at 0.01 m/s² since issue 16: slack from 226 s, was 230 s.)
+        // (The safe hold ramps at its own 0.01 m/s²: slack from 226 s.)
         "slack (T ≤ 0): 1 events, 375 s",
         "slack episodes: 226–601 s",
     ] {
@@ -979,7 +979,7 @@ fn the_fault_demo_raises_every_fault_and_still_completes_the_mission() {
 
 /// HZ-13 (a mission that stops progressing). α reads 5° high: the biased equilibrium of
 /// stage 2 lies short of the 2 km keep, so retrieval settles at ≈ 2 364 m and would stay in
-/// Retrieve for ever without a word (issue 16). The core reports it (report only, see
+/// Retrieve for ever without a word. The core reports it (report only, see
 /// `Flags::NO_PROGRESS`): the flag and a `NoProgress(Retrieve)` event once the phase has not
 /// come 1 m (the keep capture) closer for 5 × 1/c = 10 000 s.
 #[test]
@@ -1023,9 +1023,9 @@ fn the_paper_mission_never_stalls() {
     assert!(h.samples.iter().all(|s| s.flags & Flags::NO_PROGRESS == 0));
 }
 
-/// The safe hold ramps at its own 0.01 m/s², whatever the envelope: with the paper's
-/// 15 m/s² the ramp used to stop a fast wind-in in one tick, a one-tick tension spike of
-/// −300 to −626 N (issue 16). A 60 s dropout during the fast retrieval (t = 30 000 s).
+/// The safe hold ramps at its own 0.01 m/s², whatever the envelope: at the paper's 15 m/s² the
+/// ramp would stop a fast wind-in in one tick, a one-tick tension spike of −300 to −626 N. A
+/// 60 s dropout during the fast retrieval (t = 30 000 s).
 #[test]
 fn safe_hold_during_fast_retrieval_ramps_gently() {
     let h = run(

@@ -20,7 +20,7 @@ use tss_sim::scenario::Scenario;
 
 use tss_reel::recordings::replay as replay_data;
 
-/// Control periods recorded (12 minutes at 1 s: the flash budget of issue 7 holds 48 KiB).
+/// Control periods recorded (12 minutes at 1 s: the recording's flash budget holds 48 KiB).
 const TICKS: usize = 720;
 
 fn root() -> PathBuf {

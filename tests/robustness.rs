@@ -1,5 +1,5 @@
-//! Proof that bad input never becomes a bad command (issue 5): property tests over the whole
-//! input space of the step function.
+//! Proof that bad input never becomes a bad command: property tests over the whole input space
+//! of the step function.
 //!
 //! Every field of every sample is drawn from all 2³² f32 bit patterns (NaN with any payload,
 //! ±inf, subnormals, ±0, huge values) or from a plausible physical range, in random sequences

@@ -619,8 +619,9 @@ mod tests {
         assert_eq!(tick_label(2.5e-5, 1e-4), "0.000025");
     }
 
-    /// Issue 30 §5: the elastic Fig. 4(b), a tension jumping between 0 and 20 N from sample to
-    /// sample, was drawn with spikes down to the bottom of the image, below the plot area.
+    /// A curve stays inside its panel: the elastic Fig. 4(b), a tension jumping between 0 and
+    /// 20 N from sample to sample, must not be drawn with spikes down to the bottom of the
+    /// image, below the plot area.
     #[test]
     fn a_jumping_curve_stays_inside_its_panel() {
         let (w, h) = (600u32, 300u32);

@@ -437,9 +437,9 @@ mod tests {
         );
     }
 
-    /// Issue 16 §2: with `controller.k1_per_s = 1e30` the run kept a 4 m tether while the phases
-    /// ran on, and the summary said "retrieval reaches 2 km at 8.000 h" and gave a stage-1
-    /// "overshoot" of −29 996 m.
+    /// A tether that never moves reaches no milestone: with `controller.k1_per_s = 1e30` the run
+    /// keeps a 4 m tether while the phases run on, and the summary must not say "retrieval
+    /// reaches 2 km at 8.000 h" nor give a stage-1 "overshoot" of −29 996 m.
     #[test]
     fn a_tether_that_never_moves_reaches_nothing() {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/paper.toml");

@@ -1,5 +1,5 @@
-//! What a new user meets on the command line (issue 15 §5): shell completions, `--quiet`, and
-//! `-o DIR` on every command that writes files.
+//! What a new user meets on the command line: shell completions, `--quiet`, and `-o DIR` on
+//! every command that writes files.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -83,8 +83,8 @@ fn every_command_that_writes_files_takes_dash_o() {
     }
 }
 
-/// A PIL scenario longer than the firmware's bound (`link::MAX_TICKS` periods) used to run for
-/// 200 000 periods and then fail; it is refused before QEMU starts (exit 2). Any existing file
+/// A PIL scenario longer than the firmware's bound (`link::MAX_TICKS` periods) is refused
+/// before QEMU starts (exit 2), not run for 200 000 periods to fail then. Any existing file
 /// passes the `--firmware` check, so this needs no ELF.
 #[test]
 fn a_pil_run_longer_than_the_firmware_allows_is_refused_before_it_starts() {
@@ -122,8 +122,8 @@ fn values_the_simulation_refuses_before_its_first_step_are_usage_errors() {
     assert!(!out.exists());
 }
 
-/// Issue 28 §3: with stderr not a terminal (a batch job's log) a run printed nothing until it
-/// ended. It prints a line per simulated hour (and nothing under `--quiet`, above).
+/// With stderr not a terminal (a batch job's log) a run is not silent until it ends: it prints
+/// a line per simulated hour (and nothing under `--quiet`, above).
 #[test]
 fn a_run_logs_its_progress_every_simulated_hour_when_not_on_a_terminal() {
     let tmp = tempfile::tempdir().unwrap();
@@ -149,10 +149,9 @@ fn paper_in(cwd: &Path, command: &str, args: &[&str]) -> Output {
         .expect("tss-sim runs")
 }
 
-/// Issue 30 §5: the README's eccentric example (`run scenarios/paper.toml --set
-/// orbit.eccentricity=0.1 …`, no `--out`) replaced the results of the plain `run
-/// scenarios/paper.toml` in out/paper. A run with overrides writes beside it, and a PIL run
-/// too.
+/// The README's eccentric example (`run scenarios/paper.toml --set orbit.eccentricity=0.1 …`,
+/// no `--out`) must not replace the results of the plain `run scenarios/paper.toml` in
+/// out/paper. A run with overrides writes beside it, and a PIL run too.
 #[test]
 fn a_run_without_out_never_replaces_another_runs_results() {
     let tmp = tempfile::tempdir().unwrap();
@@ -207,8 +206,8 @@ fn a_run_without_out_never_replaces_another_runs_results() {
     assert_eq!(dirs(&tmp.path().join("out").join(&first[0])), with_compare);
 }
 
-/// Issue 30 §5: a rigid run listed its figures under a heading about the tether's shape on the
-/// elastic plant.
+/// A rigid run lists its figures as the paper's Figs. 4–6, not under a heading about the
+/// tether's shape on the elastic plant.
 #[test]
 fn a_rigid_run_s_figures_are_not_said_to_show_the_tether_s_shape() {
     let tmp = tempfile::tempdir().unwrap();
@@ -223,7 +222,8 @@ fn a_rigid_run_s_figures_are_not_said_to_show_the_tether_s_shape() {
     assert!(!stdout.contains("shape"), "{stdout}");
 }
 
-/// Issue 28 §3: `compare --laws paper,paper` flew the law once and said nothing.
+/// `compare --laws paper,paper` is refused, rather than flying the law once and saying
+/// nothing.
 #[test]
 fn compare_refuses_a_law_named_twice() {
     let tmp = tempfile::tempdir().unwrap();

@@ -1,5 +1,5 @@
-//! The classic laws beside the paper's (issue 20 §2–3): `[controller] law`, the tension laws in
-//! the closed loop on both plants, and `tss-sim compare`.
+//! The classic laws beside the paper's: `[controller] law`, the tension laws in the closed loop
+//! on both plants, and `tss-sim compare`.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

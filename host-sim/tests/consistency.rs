@@ -1,14 +1,14 @@
 //! The flight estimator's consistency over a small Monte Carlo campaign
-//! (`tss-sim montecarlo --consistency`, issue 18): NIS inside its two-sided 95 % χ² band, the
-//! NEES not above its band (the filter is never over-confident), and an α bias the filter
-//! cannot observe driving the (α, α̇) NEES out while α̇'s stays in. The filter judged is the
-//! controller's own, in the loop; with an α̇ sensor flying the law, the same filter run beside
-//! it on the same readings.
+//! (`tss-sim montecarlo --consistency`): NIS inside its two-sided 95 % χ² band, the NEES not
+//! above its band (the filter is never over-confident), and an α bias the filter cannot observe
+//! driving the (α, α̇) NEES out while α̇'s stays in. The filter judged is the controller's own, in
+//! the loop; with an α̇ sensor flying the law, the same filter run beside it on the same
+//! readings.
 //!
 //! The campaign: 20 runs of the paper mission's first 3 h (deployment, the band, reaching
-//! 30 km), the swing sensor at issue 18's σ_α = 1e-4 rad, the initial angle dispersed. The
-//! rigid plant has none of the disturbances the filter's process noise stands for
-//! (out-of-plane coupling, elasticity, orbit and reel errors), so its NEES sits below the
+//! 30 km), the swing sensor at σ_α = 1e-4 rad (the flight sensor's floor), the initial angle
+//! dispersed. The rigid plant has none of the disturbances the filter's process noise stands
+//! for (out-of-plane coupling, elasticity, orbit and reel errors), so its NEES sits below the
 //! degrees of freedom: a conservative filter, which is the safe side; the NIS, dominated by the
 //! sensor noise, is χ²(1).
 

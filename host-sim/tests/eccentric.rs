@@ -1,10 +1,10 @@
-//! Station keeping on eccentric orbits (issue 20 §1, docs/equations.md §16): the paper's mission
-//! flown by the flight core (f32) on the rigid plant, with the librating reference and the
-//! tension protection (§14, its free tension on the orbit's μ/R³: §16.7). Before the librating
-//! reference the law fought the orbit's forcing with the reel: at e = 0.1 (a = 7 800 km) the
-//! 30 km keep erred by 1 711.8 m (the summary's Table-1 figure), at e = 0.3 (a = 10 000 km) by
-//! 4 762 m. Before the protection's μ/R³ the protected missions went slack (e = 0.1) or docked
-//! (e = 0.3); without the protection the paper's law goes slack (O-10).
+//! Station keeping on eccentric orbits (docs/equations.md §16): the paper's mission flown by the
+//! flight core (f32) on the rigid plant, with the librating reference and the tension
+//! protection (§14, its free tension on the orbit's μ/R³: §16.7). Without the librating
+//! reference the law fights the orbit's forcing with the reel: at e = 0.1 (a = 7 800 km) the
+//! 30 km keep errs by 1 711.8 m (the summary's Table-1 figure), at e = 0.3 (a = 10 000 km) by
+//! 4 762 m. With a circular orbit's θ̇² in place of μ/R³ the protected missions go slack
+//! (e = 0.1) or dock (e = 0.3); without the protection the paper's law goes slack (O-10).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -79,10 +79,10 @@ fn at_e_0_1_the_saturated_slew_hand_over_stays_taut() {
 
 #[test]
 fn at_e_0_3_the_flight_scenario_retrieves_to_the_2_km_keep_taut() {
-    // scenarios/paper-eccentric.toml as it stands (e = 0.3, protection on). With θ̇² for μ/R³
-    // the retrieval overshot the 2 km keep near apogee, the law faulted, and the safe hold,
-    // on a stale free tension below T_min, wound the tether in to docking (0.5 m). Now: keeps
-    // within 1.2 cm and 0.4 cm, least tension 0.70 mN.
+    // scenarios/paper-eccentric.toml as it stands (e = 0.3, protection on): keeps within 1.2 cm
+    // and 0.4 cm, least tension 0.70 mN. With θ̇² for μ/R³ the retrieval overshoots the 2 km
+    // keep near apogee, the law faults, and the safe hold, on a stale free tension below T_min,
+    // winds the tether in to docking (0.5 m).
     let r = fly(&scenario("paper-eccentric.toml"), &[]);
     assert_eq!(r.eccentricity, 0.3);
     assert!(r.keep1_error_m < 0.02, "{r:?}");
@@ -172,11 +172,10 @@ fn eccentric_writes_its_table_csv_and_figure() {
     assert_eq!(bad.status.code(), Some(2));
 }
 
-/// Issue 30 §5: `eccentric scenarios/paper-eccentric.toml` wrote to
-/// out/paper-eccentric-eccentric, and its table showed a "Table 1 stage 2" column although
-/// the scenario's stage 2 starts at 16 h, not at the paper's 8 h: Table 1's stage-2 instants
-/// (14–15 h) then fall in the stage-1 keep. The sweep writes to out/paper-eccentric/eccentric
-/// and leaves the column out.
+/// `eccentric scenarios/paper-eccentric.toml` writes to out/paper-eccentric/eccentric (not
+/// out/paper-eccentric-eccentric), and its table has no "Table 1 stage 2" column: the
+/// scenario's stage 2 starts at 16 h, not at the paper's 8 h, so Table 1's stage-2 instants
+/// (14–15 h) fall in the stage-1 keep and such a column would mean nothing.
 #[test]
 fn eccentric_writes_beside_the_scenario_s_runs_without_a_meaningless_column() {
     let tmp = tempfile::tempdir().unwrap();

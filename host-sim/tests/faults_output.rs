@@ -98,8 +98,8 @@ fn a_tumbling_tether_is_headlined_as_a_failure() {
     assert!(faults.contains("past π/2 (tumbled)"), "{faults}");
 }
 
-/// Issue 28 §3 (and §1's second case): α read as 0 from 1 h on; the tether went slack. The
-/// slack tether and the mission that went no further are the headline and the verdict.
+/// α read as 0 from 1 h on: the tether goes slack. The slack tether and the mission that goes
+/// no further are the headline and the verdict.
 #[test]
 fn a_slack_tether_is_headlined_as_a_failure() {
     let (stdout, verdict, _) = fly(
@@ -116,8 +116,8 @@ fn a_slack_tether_is_headlined_as_a_failure() {
     assert!(verdict.contains("\"kind\": \"slack\""), "{verdict}");
 }
 
-/// Issue 28 §1's first case: the swing sensor stuck from 1 h, deployment stalled at 17.8 km
-/// with health nominal; the run's headline said nothing of it.
+/// The swing sensor stuck from 1 h stops deployment short of the keep (undetected, it stalls
+/// at 17.8 km with health nominal); the run's headline and verdict say the mission stalled.
 #[test]
 fn a_stalled_mission_is_headlined_as_a_failure() {
     let (stdout, verdict, _) = fly(
@@ -145,8 +145,8 @@ fn a_run_without_failures_passes() {
     assert!(verdict.contains("\"passed\": true") && verdict.contains("\"failures\": []"));
 }
 
-/// Issue 28 §3: a sensed length stuck at 1 km deploys the tether for ever; on main it paid
-/// out past the spool's 40 km and on. The run stops at the spool's end and says so.
+/// A sensed length stuck at 1 km deploys the tether for ever: without the spool's bound it
+/// pays out past the spool's 40 km and on. The run stops at the spool's end and says so.
 #[test]
 fn a_tether_paid_out_past_its_spool_stops_the_run_and_fails_it() {
     let (stdout, verdict, _) = fly(
@@ -168,7 +168,8 @@ fn a_tether_paid_out_past_its_spool_stops_the_run_and_fails_it() {
     assert!(end < 40_000.0, "the run went on to {end} s");
 }
 
-/// Issue 28 §3: a motor reel's run printed "injected: nothing (perfect sensors, ideal reel)".
+/// A motor reel's run does not say "injected: nothing (perfect sensors, ideal reel)": it names
+/// the motor drum.
 #[test]
 fn a_motor_reel_is_not_called_an_ideal_reel() {
     let (_, _, faults) = fly("paper-elastic.toml", &["simulation.duration_s=60"]);
@@ -176,7 +177,7 @@ fn a_motor_reel_is_not_called_an_ideal_reel() {
     assert!(faults.contains("reel: the motor drum"), "{faults}");
 }
 
-/// Issue 28 §3: `reel.locked = true` paid out while the lag drive decayed from l̇(0).
+/// `reel.locked = true` pays out nothing, even while the lag drive would decay from l̇(0).
 #[test]
 fn a_locked_reel_with_a_lag_pays_out_nothing() {
     let tmp = tempfile::tempdir().unwrap();

@@ -75,7 +75,7 @@ fn a_frozen_swing_sensor_is_detected_and_held() {
 }
 
 /// α stuck at 0 (a corrupt reading) is a frozen sensor too: held before the tether tumbles
-/// (on the old main |α| passed π/2 at 5 370 s, and the summary reported nominal health). The
+/// (undetected, |α| passes π/2 at 5 370 s while the summary reports nominal health). The
 /// step to 0 is gated for 10 samples, then α restarts at 0 and the law, flying on it for the
 /// 9 periods before the run of zeros is long enough, slackens the tether briefly.
 #[test]

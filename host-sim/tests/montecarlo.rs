@@ -437,8 +437,8 @@ fn bad_dispersions_shards_and_runs_are_clear_errors() {
     rejected(&[sc, "--runs", "0"], &["--runs"]);
 }
 
-/// Issue 16 §5: absurd counts are refused before any work (exit 2, naming the flag and value),
-/// not a capacity-overflow panic (18 446 744 073 709 551 615 runs) or an aborted allocation
+/// Absurd counts are refused before any work (exit 2, naming the flag and value), not a
+/// capacity-overflow panic (18 446 744 073 709 551 615 runs) or an aborted allocation
 /// (4 000 000 000 runs); `--threads` has an upper bound too.
 #[test]
 fn absurd_runs_and_threads_are_refused_before_any_work() {
@@ -455,8 +455,8 @@ fn absurd_runs_and_threads_are_refused_before_any_work() {
     }
 }
 
-/// Issue 15 §5: a scenario without `[montecarlo]` dispersions used to fly N identical runs and
-/// report 100 % pass; it is an error that says what is missing.
+/// A scenario without `[montecarlo]` dispersions would fly N identical runs and report 100 %
+/// pass; it is an error that says what is missing.
 #[test]
 fn a_scenario_without_dispersions_is_an_error() {
     let sc = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper.toml");
@@ -466,9 +466,9 @@ fn a_scenario_without_dispersions_is_an_error() {
     );
 }
 
-/// Issue 16 §5: a campaign replaces the files of an earlier one in its directory, figures
-/// included: with --no-figures, the earlier campaign's figures are removed rather than left
-/// next to results they do not show; other files stay.
+/// A campaign replaces the files of an earlier one in its directory, figures included: with
+/// --no-figures, the earlier campaign's figures are removed rather than left next to results
+/// they do not show; other files stay.
 #[test]
 fn a_campaign_replaces_an_earlier_campaigns_files() {
     let tmp = tempfile::tempdir().unwrap();

@@ -73,7 +73,7 @@ fn a_short_mission_writes_every_file() {
     assert!(stderr.is_empty(), "stderr: {stderr}");
     assert!(stdout.contains("fig4_length_tension.png"), "{stdout}");
     assert!(stdout.contains("Summary of scenario `short`"), "{stdout}");
-    // Issue 15 §5: every file written is listed, faults.txt too.
+    // Every file written is listed, faults.txt too.
     for f in [
         "history.csv",
         "table1.csv",
@@ -292,8 +292,8 @@ fn listing(dir: &Path) -> Vec<String> {
     names
 }
 
-/// Issue 16 §5: an output directory that cannot be written used to be found only after the
-/// whole simulation (exit 1); it is a usage error (exit 2) before the simulation starts.
+/// An output directory that cannot be written is a usage error (exit 2) found before the
+/// simulation starts, not a failure (exit 1) after the whole simulation.
 #[test]
 fn an_unwritable_output_is_found_before_the_simulation() {
     let tmp = tempfile::tempdir().unwrap();
@@ -328,9 +328,9 @@ fn an_unwritable_output_is_found_before_the_simulation() {
     );
 }
 
-/// Issue 16 §5: a failed run leaves an earlier run's results as they were (no file of the failed
-/// run, no temporary file); a successful one replaces them and removes the files of the set it
-/// did not write (an earlier PIL run's pil.txt and firmware.log).
+/// A failed run leaves an earlier run's results as they were (no file of the failed run, no
+/// temporary file); a successful one replaces them and removes the files of the set it did not
+/// write (an earlier PIL run's pil.txt and firmware.log).
 #[test]
 fn a_failed_run_leaves_the_earlier_results_and_a_new_one_replaces_them_all() {
     let tmp = tempfile::tempdir().unwrap();
@@ -377,9 +377,9 @@ fn paper_elastic() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper-elastic.toml")
 }
 
-/// Issue 17: "a figure of the tether's shape at chosen times". An elastic run draws
-/// `tether_shape.png`/`.svg` (one curve per recorded shape, in the orbit plane) and lists it; a
-/// rigid run has no shape to draw, and run into the same directory it removes the earlier one.
+/// A figure of the tether's shape at chosen times: an elastic run draws `tether_shape.png`/`.svg`
+/// (one curve per recorded shape, in the orbit plane) and lists it; a rigid run has no shape to
+/// draw, and run into the same directory it removes the earlier one.
 #[test]
 fn an_elastic_run_draws_the_tethers_shape_and_a_rigid_one_does_not() {
     let tmp = tempfile::tempdir().unwrap();

@@ -1,6 +1,6 @@
 //! The flight speed loop (`tss_reel::reel_drive::SpeedLoop`, f32) flying the truth model's reel
 //! drum (`tss_sim::elastic::reel_drum::FlightDrum`: stick–slip, torque limit, spring brake) at
-//! 1 kHz with its encoder quantised, under the paper mission's rate commands (issue 19 §4).
+//! 1 kHz with its encoder quantised, under the paper mission's rate commands.
 //!
 //! The commands, their Eq. 30 accelerations and the tension at the reel are those of the
 //! closed-loop paper mission (`scenarios/paper.toml`, rigid plant, every law period), flown

@@ -1,4 +1,4 @@
-//! Resource bounds of the simulator (issue 16 §5): memory grows with what is written, never
+//! Resource bounds of the simulator: memory grows with what is written, never
 //! with what is asked.
 
 use std::path::Path;
@@ -25,9 +25,9 @@ impl Stepper<f32> for FailAfter {
     }
 }
 
-/// A mission asked for 2³² − 1 s with a sample every second: on main the loop reserved room for
-/// 4 294 967 297 samples (about 500 GB) before its first step and the process aborted; the
-/// history now holds only the samples written before the stepper failed.
+/// A mission asked for 2³² − 1 s with a sample every second: the history holds only the samples
+/// written before the stepper failed. Reserved from the asked duration, it would be room for
+/// 4 294 967 297 samples (about 500 GB) before the first step, and the process would abort.
 #[test]
 fn the_history_is_not_reserved_from_the_asked_duration() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper.toml");
@@ -62,10 +62,10 @@ fn blamed(file: &str, sets: &[&str]) -> Vec<String> {
     }
 }
 
-/// Issue 28 §3: on main the elastic plant refused none of these up front: EA = 1e18 ran at 73 s
-/// per simulated second (60 days for the mission), EA 1e20, C = 1e9, 1 m segments, courant
-/// 1e-9, J = 1e-30 and a 1 GHz inner rate hung with no output, 1 mm segments aborted on a
-/// 1.6 GB allocation. Each is refused when the scenario loads, naming the key.
+/// The elastic plant refuses work it cannot finish, when the scenario loads, naming the key.
+/// Unchecked, EA = 1e18 runs at 73 s per simulated second (60 days for the mission); EA 1e20,
+/// C = 1e9, 1 m segments, courant 1e-9, J = 1e-30 and a 1 GHz inner rate hang with no output;
+/// 1 mm segments abort on a 1.6 GB allocation.
 #[test]
 fn the_elastic_plant_refuses_work_it_cannot_finish() {
     let cases: &[(&str, &[&str], &str)] = &[

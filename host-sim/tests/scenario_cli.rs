@@ -115,7 +115,7 @@ fn a_physically_invalid_value_exits_2() {
             "initial.beta_rad = 2 must be within (−π/2, π/2)",
         ],
     );
-    // A rule of the controller's own (it used to fail the run with exit 1).
+    // A rule of the controller's own, checked with the scenario (exit 2, not a failed run).
     rejected(
         &paper(),
         &["-s", "orbit.eccentricity=0.8"],
@@ -123,7 +123,8 @@ fn a_physically_invalid_value_exits_2() {
     );
 }
 
-/// Used to abort on a 48 GB allocation: now a usage error before any work.
+/// A run too long for the simulator (unchecked, it aborts on a 48 GB allocation) is a usage
+/// error before any work.
 #[test]
 fn a_run_too_long_for_the_simulator_exits_2() {
     rejected(
@@ -246,8 +247,8 @@ fn scenario(file: &str) -> PathBuf {
         .join(file)
 }
 
-/// Issue 28 §3: a = 6 500 km (122 km of altitude) flew, paid 819 km of tether off a 40 km
-/// spool, and reported success. An orbit whose perigee is inside the atmosphere is refused.
+/// An orbit whose perigee is inside the atmosphere is refused: unchecked, a = 6 500 km (122 km
+/// of altitude) flies, pays 819 km of tether off a 40 km spool, and reports success.
 #[test]
 fn an_orbit_inside_the_atmosphere_exits_2() {
     rejected(
@@ -257,8 +258,8 @@ fn an_orbit_inside_the_atmosphere_exits_2() {
     );
 }
 
-/// Issue 28 §3: a ≥ 1e14 m blamed `orbit.eccentricity` (0, valid). It is the semi-major axis
-/// that is refused, once, and the eccentricity is not named.
+/// a ≥ 1e14 m is refused as the semi-major axis, once, and the eccentricity (0, valid) is not
+/// named.
 #[test]
 fn a_semi_major_axis_beyond_the_earths_reach_blames_the_semi_major_axis() {
     for a in ["1e14", "1e10", "1e300"] {
@@ -287,9 +288,8 @@ fn a_semi_major_axis_beyond_the_earths_reach_blames_the_semi_major_axis() {
     }
 }
 
-/// Issue 28 §3: `reel.inner_rate_hz` in 100–400 passed validation, failed when the run
-/// started, printed its message twice and named no rule. The flight drive's own rule is
-/// checked with the scenario and named once.
+/// `reel.inner_rate_hz` in 100–400 is refused by the flight drive's own rule, checked with the
+/// scenario (not when the run starts) and named once, its message printed once.
 #[test]
 fn an_inner_rate_the_flight_drive_refuses_exits_2_naming_its_rule_once() {
     for hz in ["100", "200", "400"] {
@@ -318,7 +318,7 @@ fn an_inner_rate_the_flight_drive_refuses_exits_2_naming_its_rule_once() {
     }
 }
 
-/// Issue 28 §3: each of these hung or aborted on main; refused at once with exit 2 and the key.
+/// Each of these would hang or abort the run; refused at once with exit 2 and the key.
 #[test]
 fn an_elastic_run_too_costly_to_fly_exits_2_naming_the_key() {
     rejected(

@@ -329,8 +329,8 @@ fn scatter_panel<DB: DrawingBackend>(
 mod tests {
     use super::*;
 
-    /// Issue 30 §5: a histogram of a few runs labelled its count axis 0, 0, 1, 1 (ticks at
-    /// halves, written as whole numbers).
+    /// A histogram of a few runs labels each whole count once: with ticks at halves written as
+    /// whole numbers, its count axis would read 0, 0, 1, 1.
     #[test]
     fn a_histogram_s_count_labels_do_not_repeat() {
         let mut svg = String::new();

@@ -611,7 +611,8 @@ fn values_that_overflow_the_controllers_f32_are_rejected() {
 }
 
 /// Every size has a bound, checked at load (before any work), naming the field and value.
-/// `simulation.duration_s = 4294967295` used to pass and abort the run on a 48 GB allocation.
+/// Without it, `simulation.duration_s = 4294967295` passes and aborts the run on a 48 GB
+/// allocation.
 #[test]
 fn every_size_and_count_has_a_bound() {
     let window = "{ from_s = 1, until_s = 2 }";
@@ -733,9 +734,9 @@ fn conversions_keep_the_meaning_of_the_defaults() {
     assert_eq!(cfg.envelope.max_rate_mps, 10.0);
 }
 
-/// Issue 28 §3: a campaign accepted dispersions that change nothing (the lag drive's keys
-/// under the flight drive, the protection's with the protection off, the α̇ sensor's with no
-/// α̇ sensor) and the output interval, whose drawn values are never whole periods (every run
+/// A campaign refuses dispersions that change nothing (the lag drive's keys under the flight
+/// drive, the protection's with the protection off, the α̇ sensor's with no α̇ sensor) and the
+/// output interval, whose drawn values are never whole periods (every run would end
 /// "did_not_complete"). Each is refused, with the reason.
 #[test]
 fn dispersions_that_change_nothing_are_refused() {
