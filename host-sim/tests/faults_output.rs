@@ -116,8 +116,9 @@ fn a_slack_tether_is_headlined_as_a_failure() {
     assert!(verdict.contains("\"kind\": \"slack\""), "{verdict}");
 }
 
-/// The swing sensor stuck from 1 h stops deployment short of the keep (undetected, it stalls
-/// at 17.8 km with health nominal); the run's headline and verdict say the mission stalled.
+/// The swing sensor stuck from 1 h: the controller finds it stuck and holds the reel in safe
+/// hold, so the deployment stops short of the keep; the run's headline and verdict say the
+/// mission stalled.
 #[test]
 fn a_stalled_mission_is_headlined_as_a_failure() {
     let (stdout, verdict, _) = fly(
