@@ -2,8 +2,9 @@
 """Where the instructions of one control tick go, in the flight firmware itself.
 
 Runs a firmware ELF in QEMU (mps2-an386) with one instruction per translation block and the
-execution log on (`-singlestep -d exec,nochain`), cuts the log at SysTick entries into control
-ticks, and attributes every instruction of tick N to the source function it came from, through
+execution log on (`-singlestep -d exec,nochain`), cuts the log at SysTick entries into SysTick
+periods (1 ms: SysTick runs the speed loop at 1 kHz, and every thousandth period also holds a
+control step), and attributes every instruction of period N to the source function it came from, through
 the inlining chain (llvm-symbolizer --inlining). So the breakdown is that of the flight codegen,
 with everything LLVM inlined into `Controller::step` sorted back into the paper's pieces.
 
@@ -22,9 +23,10 @@ then report; or `Controller::step` or `::decide`, whichever LLVM kept as a funct
 return to the caller. The trace is streamed through a pipe, not stored (a late step is some 4·10^7 lines in).
 
 Defaults: the flight firmware (target/thumbv7em-none-eabihf/firmware/tss-reel, build it with
-`cargo fw-build`), tick 301 (a nominal deploy step that logs nothing). Needs qemu-system-arm
-and llvm-symbolizer (Debian: apt-get install llvm). The trace of 900 ticks is about 150 MB and
-is written to a temporary directory. Figures only; not part of CI.
+`cargo fw-build`), SysTick period 301. Needs qemu-system-arm
+and llvm-symbolizer (Debian: apt-get install llvm). Either trace is streamed through a pipe,
+never stored (the firmware's SysTick runs the 1 kHz speed loop, so a late period is some 10^8
+lines in). Figures only; not part of CI.
 """
 import argparse
 import collections
@@ -153,23 +155,28 @@ def mission_step_pcs(elf, n):
 
 
 def firmware_tick_pcs(elf, tick):
-    """The PCs of control tick `tick` of the firmware: SysTick entry to the next one."""
+    """The PCs of SysTick period `tick` of the firmware: SysTick entry to the next one, read
+    from a pipe (QEMU stops as soon as the period has passed)."""
     with tempfile.TemporaryDirectory() as tmp:
-        log = os.path.join(tmp, "trace.log")
-        subprocess.run(QEMU + ["-D", log, "-kernel", elf],
-                       stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, check=True,
-                       timeout=600)
+        fifo = os.path.join(tmp, "trace.fifo")
+        os.mkfifo(fifo)
+        qemu = subprocess.Popen(QEMU + ["-D", fifo, "-kernel", elf],
+                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL)
         pcs, ticks, prev = [], -1, None
-        with open(log) as f:
-            for pc, line in trace_pcs(f):
-                name = line.rsplit("]", 1)[1].strip()
-                if name == "SysTick" and prev != "SysTick":
-                    ticks += 1
-                    if ticks == tick + 1:
-                        break
-                prev = name
-                if ticks == tick:
-                    pcs.append(pc)
+        try:
+            with open(fifo) as f:
+                for pc, line in trace_pcs(f):
+                    name = line.rsplit("]", 1)[1].strip()
+                    if name == "SysTick" and prev != "SysTick":
+                        ticks += 1
+                        if ticks == tick + 1:
+                            break
+                    prev = name
+                    if ticks == tick:
+                        pcs.append(pc)
+        finally:
+            qemu.kill()
+            qemu.wait()
     if not pcs:
         sys.exit(f"trace_profile: tick {tick} not reached")
     return pcs
