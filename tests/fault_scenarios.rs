@@ -676,8 +676,8 @@ fn spool_end_holds_with_a_lagging_drive() {
         );
         assert_envelope(f, 0.0);
     }
-    // Without the protection the same drive passes the spool end (the hazard itself): the
-    // simulator stops the run where the tether leaves the spool.
+    // With the protection not told the drive's lag, the same drive passes the spool end (the
+    // hazard itself): the simulator stops the run where the tether leaves the spool.
     let h = run(
         REEL_LIMITS,
         &[
@@ -689,7 +689,7 @@ fn spool_end_holds_with_a_lagging_drive() {
     );
     let overrun = h
         .spool_overrun
-        .expect("the unprotected drive runs off the spool");
+        .expect("a drive whose lag the protection does not know runs off the spool");
     assert!(overrun.length_m > overrun.spool_m, "{overrun:?}");
     assert!(
         h.faults.max_excursion_m > 0.0,
@@ -730,14 +730,14 @@ fn early_safe_hold_slackens_the_short_tether_but_deployment_resumes() {
 /// l ≈ 26 m, t ≈ 1051 s: the tether swings back to α ≈ −70°, where Eq. 5a's free tension
 /// vanishes). With the protection (scenarios/paper-reel-limits.toml: T_min = 2 mN, on the
 /// true tension at the reel) the tether keeps its margin from the first tension sample on
-/// (T_min, or a quarter of 3 m_r n² l on a short tether: measured min 2.000 mN at 2 327 s): the
+/// (T_min, or a quarter of 3 m_r n² l on a short tether: measured min 2.000 mN): the
 /// pay-out brakes, then winds in 1.1 m while the swing passes (the bound acts on l̈, not on
 /// the direction), and resumes. The cost, measured on the paper's envelope: the 30 km keep is
 /// reached 230 s *earlier* (11 580 s against 11 810 s: the braking damps the swing), Table-1
 /// lengths at 2 h / 4 h / 6 h of 2 461.9 / 29 661.4 / 29 999.19 m against 2 048.0 / 29 601.9 /
 /// 29 999.51 m, 8 h within 3 mm of 30 km either way, the Table-1 instants (7–8 h) within
 /// 3.1 cm of the unprotected run. Table 1 itself (paper.toml, no protection) is unchanged.
-/// The bound starts once, in one stretch (680–2 397 s): no chatter.
+/// The bound starts once, in one stretch: no chatter.
 #[test]
 fn the_protection_keeps_the_tension_margin_from_release() {
     let h = run(
