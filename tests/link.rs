@@ -7,9 +7,11 @@
 use proptest::prelude::*;
 use tss_reel::link::{
     decode, encode, Command, End, Frame, FrameReader, Gate, Hello, LinkCounters, LinkError,
-    LoadVerdict, Loaded, Message, ParamTable, Report, Sample, SampleGate, DELIMITER, MAX_WIRE_LEN,
-    PARAM_WORDS, SAMPLE_MISSING, SAMPLE_VALID,
+    LoadVerdict, Loaded, Message, Packet, ParamTable, Report, Sample, SampleGate, DELIMITER,
+    MAX_FRAME_LEN, MAX_PACKET_LEN, MAX_WIRE_LEN, PARAM_WORDS, SAMPLE_MISSING, SAMPLE_VALID,
+    VERSION,
 };
+use tss_reel::pus::{self, ModeCommand, Telecommand, MAX_TC_LEN, MAX_TM_LEN};
 
 /// Cases per property: the issue asks for at least 100 000 on the decoder. `TSS_LINK_CASES`
 /// asks for more (a longer fuzzing run by hand).
@@ -118,6 +120,8 @@ fn message() -> impl Strategy<Value = Message> {
                     rule,
                 })
             ),
+        proptest::collection::vec(any::<u8>(), 1..=MAX_PACKET_LEN)
+            .prop_map(|b| Message::Packet(Packet::new(&b).expect("1 ..= MAX_PACKET_LEN bytes"))),
         (
             proptest::array::uniform13(any::<u32>()),
             any::<u32>(),
@@ -247,6 +251,118 @@ proptest! {
         let ok = read_all(&stream).into_iter().filter(|r| r.is_ok()).count();
         prop_assert!(ok >= valid);
     }
+}
+
+/// A decoded frame's bytes `raw` (header and body) closed by their CRC and COBS-encoded, as
+/// a sender that does not follow the layout would put them on the wire.
+fn forge(raw: &[u8]) -> Vec<u8> {
+    const CRC32: crc::Crc<u32, crc::NoTable> =
+        crc::Crc::<u32, crc::NoTable>::new(&crc::CRC_32_ISO_HDLC);
+    let mut v = raw.to_vec();
+    v.extend_from_slice(&CRC32.checksum(raw).to_le_bytes());
+    let mut out = vec![0u8; v.len() + v.len() / 254 + 2];
+    let n = cobs::try_encode(&v, &mut out).unwrap();
+    out.truncate(n);
+    out
+}
+
+/// The header and body of a `Packet` frame (kind 7) that declares `len` bytes and carries
+/// `bytes`.
+fn packet_frame(len: u16, bytes: &[u8]) -> Vec<u8> {
+    let mut raw = vec![VERSION, 9, 0, 0, 0, 7];
+    raw.extend_from_slice(&len.to_le_bytes());
+    raw.extend_from_slice(bytes);
+    raw
+}
+
+/// The longest telecommand (the parameter-table load) and telemetry packet (housekeeping)
+/// each travel in one `Packet` frame and come out byte for byte, in the documented layout.
+#[test]
+fn packets_roundtrip_in_the_documented_layout() {
+    assert_eq!(MAX_PACKET_LEN, MAX_TC_LEN.max(MAX_TM_LEN));
+    let table = ParamTable::from_config(&tss_reel::controller::Config::flight());
+    let mut tc = [0u8; MAX_TC_LEN];
+    let n = pus::encode(&Telecommand::LoadParams(table), 5, &mut tc).unwrap();
+    assert_eq!(n, MAX_TC_LEN);
+    let mut hold = [0u8; MAX_TC_LEN];
+    let short = pus::encode(&Telecommand::Mode(ModeCommand::Hold), 6, &mut hold).unwrap();
+    for bytes in [
+        &tc[..n],
+        &hold[..short],
+        &[0u8; MAX_TM_LEN][..],
+        &[0x18][..],
+    ] {
+        let m = Message::Packet(Packet::new(bytes).unwrap());
+        let w = wire(9, &m);
+        assert!(w.len() <= MAX_WIRE_LEN);
+        let f = decode(&w).unwrap();
+        assert_eq!(f.message, m);
+        let Message::Packet(p) = f.message else {
+            unreachable!()
+        };
+        assert_eq!(p.bytes(), bytes);
+        // Kind 7, its length u16 little-endian, its bytes: the same as a frame forged by hand.
+        assert_eq!(
+            w[..w.len() - 1],
+            forge(&packet_frame(bytes.len() as u16, bytes))[..]
+        );
+    }
+    // The longest packet makes the longest frame (header, length, packet, CRC).
+    assert_eq!(MAX_FRAME_LEN, packet_frame(0, &tc[..n]).len() + 4);
+}
+
+/// A packet cut short (fewer bytes than its length says, or not even its length) is
+/// truncated; an empty one, or one longer than the longest telecommand or telemetry packet
+/// (declared or carried), is malformed; neither is ever handed on.
+#[test]
+fn truncated_empty_and_oversized_packets_are_rejected() {
+    let bytes = [0x18u8; MAX_PACKET_LEN + 1];
+    assert!(decode(&forge(&packet_frame(20, &bytes[..20]))).is_ok());
+    assert_eq!(
+        decode(&forge(&packet_frame(20, &bytes[..19]))),
+        Err(LinkError::Truncated)
+    );
+    assert_eq!(
+        decode(&forge(&packet_frame(
+            MAX_PACKET_LEN as u16,
+            &bytes[..MAX_PACKET_LEN - 1]
+        ))),
+        Err(LinkError::Truncated)
+    );
+    assert_eq!(
+        decode(&forge(&[VERSION, 9, 0, 0, 0, 7, 20])),
+        Err(LinkError::Truncated)
+    );
+    assert_eq!(
+        decode(&forge(&packet_frame(0, &[]))),
+        Err(LinkError::Malformed)
+    );
+    assert_eq!(
+        decode(&forge(&packet_frame(20, &bytes[..21]))),
+        Err(LinkError::Malformed),
+        "bytes beyond the declared length"
+    );
+    // Declared longer than the longest packet, with the bytes to match or without them.
+    assert_eq!(
+        decode(&forge(&packet_frame(MAX_PACKET_LEN as u16 + 1, &bytes))),
+        Err(LinkError::Overflow),
+        "a frame longer than the longest one overflows the receiver first"
+    );
+    assert_eq!(
+        decode(&forge(&packet_frame(
+            MAX_PACKET_LEN as u16 + 1,
+            &bytes[..4]
+        ))),
+        Err(LinkError::Malformed)
+    );
+    assert_eq!(
+        decode(&forge(&packet_frame(u16::MAX, &bytes[..4]))),
+        Err(LinkError::Malformed)
+    );
+    // The sender cannot make one either.
+    assert_eq!(Packet::new(&[]), None);
+    assert_eq!(Packet::new(&bytes), None);
+    assert!(Packet::new(&bytes[..MAX_PACKET_LEN]).is_some());
 }
 
 /// What the plant's injector does to one sample frame (`host-sim/src/pil.rs`).

@@ -176,7 +176,8 @@ impl Link {
                 | Message::Command(_)
                 | Message::Report(_)
                 | Message::Params(_)
-                | Message::Loaded(_) => {
+                | Message::Loaded(_)
+                | Message::Packet(_) => {
                     self.counters.count_error(LinkError::WrongKind);
                     defmt::warn!(
                         "link: unexpected frame kind discarded (seq={=u32})",

@@ -12,6 +12,7 @@ use super::params::{rule_code, TableError, PARAMS};
 use crate::controller::Output;
 
 use super::error::LinkError;
+use super::packet::Packet;
 use super::params::ParamTable;
 
 /// What arrived for one control period, as the firmware reports it back in each
@@ -276,7 +277,7 @@ pub struct Loaded {
 pub const NO_PARAM: u8 = 0xff;
 
 /// One message: the frame's kind and body.
-// The parameter table is the one large body, sent once a run; a no_std link has no heap to
+// The parameter table and a space packet are the large bodies; a no_std link has no heap to
 // box it in, and a message lives in one receive slot whatever its kind.
 #[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -296,7 +297,10 @@ pub enum Message {
     Params(ParamTable),
     /// Kind 6, firmware → plant.
     Loaded(Loaded),
+    /// Kind 7, both ways: a PUS telecommand plant → firmware, a PUS telemetry packet
+    /// firmware → plant.
+    Packet(Packet),
 }
 
 /// Number of message kinds (kind bytes `0 .. KINDS`).
-pub const KINDS: u8 = 7;
+pub const KINDS: u8 = 8;

@@ -6,7 +6,7 @@
 //! every malformed frame with a typed [`LinkError`] (the property test `tests/link.rs` feeds it
 //! arbitrary and mutated bytes).
 //!
-//! # Frame layout (version [`VERSION`] = 3)
+//! # Frame layout (version [`VERSION`] = 4)
 //!
 //! On the wire a frame is its COBS encoding (Cheshire & Baker 1999: no `0x00` inside) followed
 //! by one `0x00` delimiter, so a receiver can resynchronise on the next `0x00` after any error.
@@ -20,7 +20,7 @@
 //! 1       4     seq      u32       sender's frame counter from 0, +1 per new frame (a repeat
 //!                                  keeps it)
 //! 5       1     kind     u8        0 Hello, 1 Sample, 2 Command, 3 End, 4 Report, 5 Params,
-//!                                  6 Loaded
+//!                                  6 Loaded, 7 Packet
 //! 6       n     body               the kind's fields, in declaration order (`messages.rs`)
 //! 6+n     4     crc      u32       CRC-32/ISO-HDLC over bytes 0 .. 6+n
 //! ```
@@ -54,14 +54,21 @@
 //! Report  (firmware → plant, the answer to End, n = 4 × 15)
 //!         the firmware's LinkCounters, then commands u32 (sent), then digest u32 (FNV-1a over
 //!         the bit patterns of every rate command, as the replay mission's)
+//! Packet  (both ways, n = 2 + len, len = 1 ..= MAX_PACKET_LEN = 297)
+//!         len u16, then one CCSDS space packet's len bytes as they are: plant → firmware a
+//!         PUS telecommand (before the period's Sample), firmware → plant a PUS telemetry
+//!         packet (before the period's Command); len 0 or beyond MAX_PACKET_LEN is
+//!         LinkError::Malformed, fewer bytes than len LinkError::Truncated
 //! ```
 //!
 //! `opt` is an optional f32 (postcard's `Option`): one byte 0 (absent), or 1 followed by the
 //! f32 (any other tag byte is [`LinkError::Malformed`]). Version 1 had no options: a sample
 //! carried α and α̇ always, and no reel rate, tension or true anomaly; a command no NIS.
 //! Version 2 had no `Params` and `Loaded`: the firmware flew its built-in configuration.
+//! Version 3 had no `Packet`: nobody could command the firmware.
 //!
-//! The largest frame (Params) is 6 + 280 + 4 = 290 bytes decoded, [`MAX_WIRE_LEN`] on the wire.
+//! The largest frame (a Packet with the longest telecommand, the parameter-table load) is
+//! 6 + 2 + 297 + 4 = 309 bytes decoded, [`MAX_WIRE_LEN`] on the wire.
 //!
 //! # What the receiver checks, in order
 //!
@@ -80,7 +87,7 @@ use serde::{Deserialize, Serialize};
 use crate::controller::Output;
 
 /// Protocol version carried in byte 0 of every frame (see the module docs).
-pub const VERSION: u8 = 3;
+pub const VERSION: u8 = 4;
 
 /// Decoded header length: version, seq, kind.
 pub const HEADER_LEN: usize = 6;
@@ -88,8 +95,18 @@ pub const HEADER_LEN: usize = 6;
 /// Length of the CRC that closes every decoded frame.
 pub const CRC_LEN: usize = 4;
 
-/// Largest decoded frame (header, the largest body, CRC), bytes: the `Params` frame's.
-pub const MAX_FRAME_LEN: usize = HEADER_LEN + 4 * PARAM_WORDS + CRC_LEN;
+/// Largest decoded frame (header, the largest body, CRC), bytes: a `Packet` frame with the
+/// longest packet, or the `Params` frame, whichever is longer.
+pub const MAX_FRAME_LEN: usize = HEADER_LEN + max(2 + MAX_PACKET_LEN, 4 * PARAM_WORDS) + CRC_LEN;
+
+/// The larger of `a` and `b`, for the constants above (`Ord::max` is not `const`).
+const fn max(a: usize, b: usize) -> usize {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
 
 /// Largest frame on the wire: COBS adds one byte per 254 (and one), plus the `0x00` delimiter.
 pub const MAX_WIRE_LEN: usize = MAX_FRAME_LEN + MAX_FRAME_LEN / 254 + 2;
@@ -103,7 +120,7 @@ pub const MAX_TICKS: u32 = 200_000;
 pub const DELIMITER: u8 = 0x00;
 
 /// CRC-32/ISO-HDLC (the Ethernet/zlib CRC): poly 0x04C11DB7 reflected, init and xorout all ones.
-/// Bitwise, without the 1 KiB lookup table: flash is tight, and a frame is at most `MAX_FRAME_LEN` (290) bytes.
+/// Bitwise, without the 1 KiB lookup table: flash is tight, and a frame is at most `MAX_FRAME_LEN` (309) bytes.
 const CRC32: crc::Crc<u32, crc::NoTable> =
     crc::Crc::<u32, crc::NoTable>::new(&crc::CRC_32_ISO_HDLC);
 
@@ -266,6 +283,7 @@ mod digest;
 mod error;
 mod gate;
 mod messages;
+mod packet;
 mod params;
 
 pub use codes::{
@@ -278,6 +296,7 @@ pub use messages::{
     Command, End, Hello, LinkCounters, LoadVerdict, Loaded, Message, Report, Sample, SampleStatus,
     KINDS, NO_PARAM, SAMPLE_MISSING, SAMPLE_VALID,
 };
+pub use packet::{Packet, MAX_PACKET_LEN};
 pub use params::{
     param_index, rule_code, rule_from_code, ParamTable, TableError, WordKind, PARAMS, PARAM_WORDS,
 };

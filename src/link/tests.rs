@@ -202,7 +202,7 @@ fn the_reader_resynchronises_after_garbage_and_overflow() {
         }
     };
     feed(&[0, 0, 1, 2, 3, 0], &mut r); // idle, then garbage
-    feed(&[0x77; 300], &mut r); // an overlong run…
+    feed(&[0x77; MAX_WIRE_LEN + 1], &mut r); // an overlong run…
     feed(&[0], &mut r); // … ends at its delimiter
     feed(&wire[..n], &mut r);
     assert_eq!(got.len(), 3);
