@@ -25,7 +25,6 @@
 
 use arbitrary_int::{u11, u14};
 use spacepackets::ecss::tc::PusTcReader;
-use spacepackets::ecss::tm::{PusTmCreator, PusTmSecondaryHeader};
 use spacepackets::ecss::{CreatorConfig, MessageTypeId, PusPacket, PusVersion};
 use spacepackets::{CcsdsPacket, PacketType, SpHeader};
 
@@ -339,24 +338,73 @@ pub fn verification_report(
         (Stage::Completion, false) => 7,
         (Stage::Completion, true) => 8,
     };
-    let mut data = [0u8; 10];
-    data.get_mut(..2)?
-        .copy_from_slice(&request.packet_id.to_be_bytes());
-    data.get_mut(2..4)?
-        .copy_from_slice(&request.sequence.to_be_bytes());
+    let [p0, p1] = request.packet_id.to_be_bytes();
+    let [s0, s1] = request.sequence.to_be_bytes();
+    let mut data = [p0, p1, s0, s1, 0, 0, 0, 0, 0, 0];
     let len = match failure.map(Failure::code_and_data) {
-        Some((code, extra)) => {
-            data.get_mut(4..6)?.copy_from_slice(&code.to_be_bytes());
-            data.get_mut(6..10)?.copy_from_slice(&extra);
+        Some((code, [d0, d1, d2, d3])) => {
+            let [c0, c1] = code.to_be_bytes();
+            data[4..].copy_from_slice(&[c0, c1, d0, d1, d2, d3]);
             10
         }
         None => 4,
     };
-    let stamp = tick.to_be_bytes();
-    let sp = SpHeader::new_for_unseg_tm(u11::new(APID), u14::new(seq & 0x3fff), 0);
-    let sec = PusTmSecondaryHeader::new(MessageTypeId::new(1, subtype), seq, 0, &stamp);
-    let tm = PusTmCreator::new(sp, sec, data.get(..len)?, CreatorConfig::default());
-    tm.write_to_slice_crc_no_table(out).ok()
+    telemetry_packet(1, subtype, seq, tick, data.get(..len)?, out)
+}
+
+/// Length of the CCSDS primary header (CCSDS 133.0-B-2 §4.1.3).
+const PRIMARY_HEADER_LEN: usize = 6;
+
+/// Length of a telemetry packet of the unit without its source data: the primary header, the
+/// PUS-C TM secondary header (7 bytes) and its time field, the packet error control
+/// (ECSS-E-ST-70-41C §7.4.3.2, §7.4.4).
+pub const TM_OVERHEAD_LEN: usize = PRIMARY_HEADER_LEN + 7 + TIME_LEN + 2;
+
+/// The packet error control's CRC-16/CCITT-FALSE (ECSS-E-ST-70-41C §B.1), without a table.
+const PACKET_CRC: crc::Crc<u16, crc::NoTable> =
+    crc::Crc::<u16, crc::NoTable>::new(&crc::CRC_16_IBM_3740);
+
+/// Writes the unit's telemetry packet TM\[`service`,`subtype`\] with source data `data` into
+/// `out`; returns its length (`None`: `out` is too short). `seq` is both its sequence count (14
+/// bits) and its message type counter, `time` its time field (the on-board time, ticks).
+///
+/// The layout is `spacepackets`' `PusTmCreator`'s (unsegmented, destination 0, time reference
+/// status 0; the unit tests prove the bytes identical), written by hand because that writer
+/// indexes slices it has checked but the compiler cannot prove in range: panic paths that
+/// `scripts/panic-check` refuses in a firmware's control path.
+///
+/// ```text
+/// primary header   0x0800 | APID, 0xC000 | seq (14 bits), packet length − 7      u16 × 3
+/// TM header        0x20 (PUS-C), service, subtype, seq u16, destination 0 u16
+/// time             TIME_LEN bytes, big-endian
+/// source data      data
+/// error control    CRC-16/CCITT-FALSE over all of the above, u16
+/// ```
+pub fn telemetry_packet(
+    service: u8,
+    subtype: u8,
+    seq: u16,
+    time: u32,
+    data: &[u8],
+    out: &mut [u8],
+) -> Option<usize> {
+    let len = TM_OVERHEAD_LEN.checked_add(data.len())?;
+    let data_length = u16::try_from(len - PRIMARY_HEADER_LEN - 1).ok()?;
+    let (body, error_control) = out.get_mut(..len)?.split_last_chunk_mut::<2>()?;
+    let [a0, a1] = (0x0800 | APID).to_be_bytes();
+    let [q0, q1] = (0xc000 | (seq & 0x3fff)).to_be_bytes();
+    let [l0, l1] = data_length.to_be_bytes();
+    let [c0, c1] = seq.to_be_bytes();
+    let [t0, t1, t2, t3] = time.to_be_bytes();
+    let head = [
+        a0, a1, q0, q1, l0, l1, 0x20, service, subtype, c0, c1, 0, 0, t0, t1, t2, t3,
+    ];
+    // Byte by byte (zip): no length to mismatch.
+    for (dst, src) in body.iter_mut().zip(head.iter().chain(data)) {
+        *dst = *src;
+    }
+    *error_control = PACKET_CRC.checksum(body).to_be_bytes();
+    Some(len)
 }
 
 #[cfg(test)]
@@ -432,6 +480,48 @@ mod tests {
             decode(&with(8, 1, &[0, 5], APID)).unwrap().command,
             Telecommand::Mode(ModeCommand::Abort)
         );
+    }
+
+    /// The hand-written telemetry packet is `spacepackets`' `PusTmCreator`'s, byte for byte,
+    /// for every length of source data the unit sends and more, and any sequence count.
+    #[test]
+    fn telemetry_packets_are_spacepackets_own() {
+        use spacepackets::ecss::tm::{PusTmCreator, PusTmSecondaryHeader};
+        let source: [u8; 100] = core::array::from_fn(|i| (i as u8).wrapping_mul(37) ^ 0x5a);
+        for (len, seq, time) in [
+            (0, 0, 0),
+            (4, 1, 7),
+            (10, 0x3fff, u32::MAX),
+            (67, 0x1234, 18_000),
+        ]
+        .into_iter()
+        .chain((0..=source.len()).map(|n| (n, n as u16 * 331, n as u32 * 997)))
+        {
+            let (service, subtype) = (3, 25);
+            let stamp = time.to_be_bytes();
+            let sp = SpHeader::new_for_unseg_tm(u11::new(APID), u14::new(seq & 0x3fff), 0);
+            let sec =
+                PusTmSecondaryHeader::new(MessageTypeId::new(service, subtype), seq, 0, &stamp);
+            let tm = PusTmCreator::new(sp, sec, &source[..len], CreatorConfig::default());
+            let mut theirs = [0u8; 200];
+            let n = tm.write_to_slice_crc_no_table(&mut theirs).unwrap();
+            let mut ours = [0u8; 200];
+            let m = telemetry_packet(service, subtype, seq, time, &source[..len], &mut ours);
+            assert_eq!(m, Some(n), "length {len}");
+            assert_eq!(ours[..n], theirs[..n], "length {len}");
+            assert_eq!(m, Some(TM_OVERHEAD_LEN + len));
+            assert_eq!(
+                telemetry_packet(
+                    service,
+                    subtype,
+                    seq,
+                    time,
+                    &source[..len],
+                    &mut ours[..n - 1]
+                ),
+                None
+            );
+        }
     }
 
     #[test]

@@ -14,18 +14,18 @@
 //!   after a step ──▶ TM[1,7] of a mode command applied, TM[5,x] per event, TM[3,25]
 //! ```
 
-use spacepackets::ecss::tm::{PusTmCreator, PusTmReader, PusTmSecondaryHeader};
-use spacepackets::ecss::{CreatorConfig, MessageTypeId};
-use spacepackets::{CcsdsPacket, SpHeader};
-
-use arbitrary_int::{u11, u14};
+use spacepackets::ecss::tm::PusTmReader;
+use spacepackets::CcsdsPacket;
 
 use crate::controller::{
     Controller, Event, EventKind, Health, Input, Mode, RateSource, TensionLoopMode,
 };
 use crate::link::{fault_code, health_code, param_index, phase_code, rule_code, NO_PARAM};
 
-use super::{decode, verification_report, Failure, RequestId, Stage, Telecommand, APID, TIME_LEN};
+use super::{
+    decode, telemetry_packet, verification_report, Failure, RequestId, Stage, Telecommand, APID,
+    TIME_LEN, TM_OVERHEAD_LEN,
+};
 
 /// The most telecommands the unit takes in one control period; any beyond are refused
 /// ([`Failure::Flood`]) unread.
@@ -43,7 +43,7 @@ pub const EVENT_LEN: usize = 6;
 
 /// The longest packet the unit sends: primary header 6, secondary header 7 + time, the
 /// housekeeping data, packet error control 2.
-pub const MAX_TM_LEN: usize = 6 + 7 + TIME_LEN + HOUSEKEEPING_LEN + 2;
+pub const MAX_TM_LEN: usize = TM_OVERHEAD_LEN + HOUSEKEEPING_LEN;
 
 /// One period's housekeeping (TM\[3,25\], structure [`HOUSEKEEPING_SID`]): the controller's
 /// output and the swing and tension it flew on.
@@ -582,13 +582,9 @@ impl Services {
 
     /// Sends TM\[`service`,`subtype`\] with `data`.
     fn send(&mut self, service: u8, subtype: u8, data: &[u8], emit: &mut dyn FnMut(&[u8])) {
-        let stamp = self.time_of(self.last_tick).to_be_bytes();
-        let sp = SpHeader::new_for_unseg_tm(u11::new(APID), u14::new(self.tm_seq & 0x3fff), 0);
-        let sec =
-            PusTmSecondaryHeader::new(MessageTypeId::new(service, subtype), self.tm_seq, 0, &stamp);
-        let tm = PusTmCreator::new(sp, sec, data, CreatorConfig::default());
         let mut out = [0u8; MAX_TM_LEN];
-        if let Ok(n) = tm.write_to_slice_crc_no_table(&mut out) {
+        let time = self.time_of(self.last_tick);
+        if let Some(n) = telemetry_packet(service, subtype, self.tm_seq, time, data, &mut out) {
             self.tm_seq = self.tm_seq.wrapping_add(1) & 0x3fff;
             emit(out.get(..n).unwrap_or(&[]));
         }
