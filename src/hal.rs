@@ -1,6 +1,7 @@
 //! Hardware abstraction: the reel MCU's sensors and actuator as small traits in the style of
-//! `embedded-hal` 1.0 (which has no encoder, ADC or capture traits), and the one function that
-//! connects them to the controller each control period.
+//! `embedded-hal` 1.0 (which has no encoder, ADC, capture or serial traits), the byte stream
+//! to the on-board computer ([`BytePort`]), and the one function that connects the sensors and
+//! the reel to the controller each control period.
 //!
 //! Every trait has an associated error whose [`Error::kind`] says what went wrong; every method
 //! is fallible; blanket implementations for `&mut T` let drivers be borrowed. The firmware's
@@ -21,6 +22,13 @@ pub enum ErrorKind {
     Corrupted,
     /// The device reported a fault of its own.
     Device,
+    /// Received bytes were lost: the receiver was not read in time (a UART overrun, or a
+    /// receive queue full).
+    Overrun,
+    /// A byte arrived damaged (a UART framing, noise or parity error).
+    Framing,
+    /// No room to send: the transmit queue is full.
+    Full,
     /// Anything else.
     Other,
 }
@@ -83,6 +91,20 @@ pub trait ReelDrive: ErrorType {
     fn command(&mut self, output: &Output<f32>) -> Result<(), Self::Error>;
 }
 
+/// A byte stream to another unit (a UART to the on-board computer), without waiting:
+/// `embedded-io`'s `Read`/`Write` cut to what a packet link needs (embedded-hal 1.0 has no
+/// serial trait). The bytes are framed by the link (`crate::link`); `crate::pus::port` is its
+/// user.
+pub trait BytePort: ErrorType {
+    /// The next received byte, if one has arrived (`Ok(None)`: none yet). Bytes lost or damaged
+    /// on the line are one `Err` (of kind [`ErrorKind::Overrun`] or [`ErrorKind::Framing`]) in
+    /// their place in the stream, reported once.
+    fn read_byte(&mut self) -> Result<Option<u8>, Self::Error>;
+    /// Queues all of `bytes` to be sent, or none of them if they do not all fit (`Err` of kind
+    /// [`ErrorKind::Full`]): a frame is never cut.
+    fn send(&mut self, bytes: &[u8]) -> Result<(), Self::Error>;
+}
+
 impl<T: LengthSensor + ?Sized> LengthSensor for &mut T {
     fn read_length_m(&mut self, tick: u32) -> Result<f32, Self::Error> {
         T::read_length_m(self, tick)
@@ -119,6 +141,15 @@ impl<T: ReelDrive + ?Sized> ReelDrive for &mut T {
     }
 }
 
+impl<T: BytePort + ?Sized> BytePort for &mut T {
+    fn read_byte(&mut self) -> Result<Option<u8>, Self::Error> {
+        T::read_byte(self)
+    }
+    fn send(&mut self, bytes: &[u8]) -> Result<(), Self::Error> {
+        T::send(self, bytes)
+    }
+}
+
 /// The devices of one reel controller.
 #[derive(Debug)]
 pub struct Devices<L, S, O, R, F> {
@@ -139,6 +170,9 @@ pub struct Devices<L, S, O, R, F> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Cycle {
+    /// The sample the controller stepped on (`None`: it stepped without one), for its
+    /// telemetry (`crate::pus::Services::after_step`).
+    pub input: Option<Input<f32>>,
     /// The first error of the length encoder or the orbit source this period, if any: the
     /// controller stepped without a sample ([`Controller::step_missing`]).
     pub sensor_error: Option<ErrorKind>,
@@ -182,7 +216,7 @@ where
             let true_anomaly_rad = dev.orbit.read_true_anomaly_rad(tick).map_err(kind)?;
             Ok((length_m, orbit_rate_radps, true_anomaly_rad))
         });
-    let (output, sensor_error, reading_error) = match sample {
+    let (output, input, sensor_error, reading_error) = match sample {
         Ok((length_m, orbit_rate_radps, true_anomaly_rad)) => {
             let alpha = dev.swing.read_alpha_rad(tick).map_err(|e| e.kind());
             let rate = dev.length.read_rate_mps(tick).map_err(|e| e.kind());
@@ -200,18 +234,21 @@ where
             };
             (
                 controller.step_with_drive(tick, Some(&input), drive),
+                Some(input),
                 None,
                 reading_error,
             )
         }
         Err(kind) => (
             controller.step_with_drive(tick, None, drive),
+            None,
             Some(kind),
             None,
         ),
     };
     let reel_error = dev.reel.command(output).err().map(|e| e.kind());
     Cycle {
+        input,
         sensor_error,
         reading_error,
         reel_error,

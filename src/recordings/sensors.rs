@@ -152,10 +152,11 @@ mod tests {
             let expected = if (DROPOUT_FROM_TICK..DROPOUT_UNTIL_TICK).contains(&tick) {
                 dropouts += 1;
                 assert_eq!(cycle.sensor_error, Some(ErrorKind::NoSample));
+                assert_eq!(cycle.input, None, "tick {tick}");
                 *direct.step_missing(tick)
             } else {
                 assert_eq!(cycle.sensor_error, None, "tick {tick}");
-                *direct.step(&Input {
+                let input = Input {
                     tick,
                     length_m: s[0],
                     reel_rate_mps: Replay.read_rate_mps(tick).ok(),
@@ -164,7 +165,10 @@ mod tests {
                     alpha_rate_radps: None,
                     orbit_rate_radps: ORBIT_RATE_RADPS,
                     true_anomaly_rad: 0.0,
-                })
+                };
+                // The sample the controller stepped on, for its housekeeping.
+                assert_eq!(cycle.input, Some(input), "tick {tick}");
+                *direct.step(&input)
             };
             let sent = dev.reel.0.take().expect("a command every tick");
             assert_eq!(
