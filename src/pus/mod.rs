@@ -32,6 +32,7 @@ pub use crate::controller::ModeCommand;
 use crate::controller::Refusal;
 use crate::link::{ParamTable, PARAM_WORDS};
 
+pub mod port;
 mod unit;
 
 pub use unit::{
