@@ -57,8 +57,8 @@ pub const TX_QUEUE_BYTES: usize = 2048;
 
 /// The receive queue a board gives the port, bytes (or line errors in their place): what the
 /// line brings in 89 ms at [`LINE_RATE_BAUD`], for the time the main loop spends in a period's
-/// work without calling [`PacketPort::receive`] (the controller step, the telecommands' checks,
-/// the telemetry's framing: milliseconds).
+/// work without calling [`PacketPort::receive`] (the telecommands' checks, the controller step,
+/// the telemetry's framing).
 pub const RX_QUEUE_BYTES: usize = 1024;
 
 /// What the port has seen and done since start (saturating counts).
