@@ -59,9 +59,11 @@ BOARD_FEATURES=nucleo-g474re
 BOARD_BIN=tss-reel-nucleo-g474re
 # shellcheck disable=SC2034 # used by the scripts that source this file
 BOARD_ELF=target/$FW_TARGET/$FW_PROFILE/$BOARD_BIN
-# The board's control path for scripts/panic-check: the outer law's cycle and the inner loop.
+# The board's control path for scripts/panic-check: the outer law's cycle (and its period
+# after the replay), the on-board computer's link (the main loop's reads, the USART2
+# interrupt) and the inner loop.
 # shellcheck disable=SC2034
-BOARD_PANIC_ROOT='^(tss_reel_nucleo_g474re::board::Outer::control(::h[0-9a-f]+)?|SysTick)$'
+BOARD_PANIC_ROOT='^(tss_reel_nucleo_g474re::board::Outer::(control|idle|listen)(::h[0-9a-f]+)?|SysTick|USART2)$'
 
 # Builds the board's flight firmware (profile `firmware`).
 build_board() {

@@ -13,6 +13,7 @@
 //! | direction / brake / enable | PA10 (D2) / PB5 (D4) / PB4 (D5), push-pull | `OutputPin` → [`HalReelDrive`] |
 //! | drum encoder, quadrature ×4 | TIM2 encoder mode, 32-bit (PA0 A0, PA1 A1) | [`QuadratureEncoder`] ([`Tim2Encoder`]) |
 //! | tension load cell amplifier | ADC1 IN15 (PB0, A3) | [`LoadCell`] ([`AdcLoadCell`]) |
+//! | on-board computer link, 115 200 Bd 8N1 | USART2, TX PA2 / RX PA3 (AF7): the ST-LINK's virtual COM port | [`BytePort`] ([`ObcPort`]) → [`PacketPort`] |
 //! | log | defmt over RTT (SWD, the ST-LINK) | — |
 //!
 //! ## Two rates
@@ -41,6 +42,35 @@
 //! (from the encoder), and the tension (from the load cell). When the replay ends the drive is
 //! put in safe hold (brake engaged, motor off) and the inner loop keeps holding it.
 //!
+//! ## The on-board computer's link (PUS over USART2)
+//! The unit's telecommands and telemetry (`tss_reel::pus`, docs/interface.md) travel on USART2
+//! as the processor-in-the-loop link frames them: one space packet per `Packet` frame (COBS,
+//! `0x00` delimiter, CRC-32). The board only moves bytes; reassembly, the hand-over to
+//! [`Services`] and the telemetry's framing are the library's [`PacketPort`], tested on the
+//! host (`tests/pus_port.rs`). docs/porting.md says how to talk to it from a PC.
+//! - **Rate**: [`LINE_RATE_BAUD`] (115 200 Bd 8N1, 11 520 bytes/s): a worst period's telemetry
+//!   (1 627 B, `tests/pus_port.rs`) takes 141 ms of the 1 s period. USART2 divides its 16 MHz
+//!   PCLK1 by 138: 115 942 Bd, 0.6 % fast, inside the ±2 % an 8N1 receiver tolerates.
+//! - **Receive, by interrupt**: the line brings 11.5 bytes per millisecond, more than the
+//!   receive FIFO (8 bytes) holds between two 1 kHz SysTicks, so the inner tick cannot poll
+//!   it. The USART2 interrupt (receive FIFO not empty) moves every byte, or the line error in
+//!   its place, into a [`RX_QUEUE_BYTES`] queue. A byte is lost only if that interrupt waits
+//!   9 byte times (780 µs): the longest it waits is one inner step (SysTick, same priority) or
+//!   one of the main loop's short critical sections (a byte, or [`TX_CHUNK_BYTES`] bytes). The
+//!   queue holds 89 ms of the line for the main loop, which drains it at every wake; a full
+//!   queue or a receiver overrun is an `Overrun` in the stream, a framing, noise or parity
+//!   error a `Framing`: the port counts them and drops the frame they fall in.
+//! - **Hand-over**: at the law period's boundary the telecommands received go to
+//!   [`Services`], then the controller steps, then its telemetry (verification, events,
+//!   housekeeping) is queued, as the host's unit does it.
+//! - **Transmit, by interrupt**: telemetry frames go whole into a [`TX_QUEUE_BYTES`] queue (or
+//!   are dropped and counted); the USART2 interrupt (transmit FIFO not full) feeds the line.
+//!
+//! When the replay ends the controller stops stepping: telecommands are still verified and
+//! housekeeping still sent each period, but a mode command is never completed. The link's
+//! counts are logged when a loss grows; the controller's events go to the on-board computer
+//! (TM\[5,x\]), not to the log.
+//!
 //! ## Faults
 //! A panic (panic-probe logs it) or any fault ends in [`HardFault`], which logs and resets the
 //! MCU: out of reset every pin is an input, so the driver's enable falls (pulled down on the
@@ -63,23 +93,29 @@ mod board {
 
     use cortex_m::interrupt::Mutex;
     use cortex_m::peripheral::syst::SystClkSource;
-    use cortex_m::peripheral::SCB;
+    use cortex_m::peripheral::{NVIC, SCB};
     use cortex_m_rt::{entry, exception, ExceptionFrame};
     use defmt_rtt as _;
+    use heapless::Deque;
     use panic_probe as _;
 
     use stm32g4xx_hal::adc::config::{AdcConfig, SampleTime};
     use stm32g4xx_hal::adc::{Adc, AdcClaim, AdcCommonExt, Configured};
-    use stm32g4xx_hal::gpio::{Analog, Output, PushPull, PA10, PB0, PB4, PB5};
+    use stm32g4xx_hal::gpio::{Analog, Output, PushPull, AF7, PA10, PA2, PA3, PB0, PB4, PB5};
+    use stm32g4xx_hal::hal_02::serial::{Read as _, Write as _};
+    use stm32g4xx_hal::nb;
     use stm32g4xx_hal::prelude::*;
     use stm32g4xx_hal::pwm::{ActiveHigh, ComplementaryDisabled, Pwm, C1};
     use stm32g4xx_hal::pwr::PwrExt;
     use stm32g4xx_hal::rcc::{Config as ClockConfig, Enable, Reset};
-    use stm32g4xx_hal::stm32::{self, ADC1, TIM1, TIM2};
+    use stm32g4xx_hal::serial::{self, FullConfig, NoDMA};
+    use stm32g4xx_hal::stm32::{self, interrupt, Interrupt, ADC1, TIM1, TIM2, USART2};
     use stm32g4xx_hal::time::RateExtU32;
 
     use tss_reel::controller::{Config, Controller};
-    use tss_reel::hal::{control_cycle, Devices, ErrorKind, ErrorType, ReelDrive};
+    use tss_reel::hal::{control_cycle, BytePort, Devices, ErrorKind, ErrorType, ReelDrive};
+    use tss_reel::pus::port::{PacketPort, LINE_RATE_BAUD, RX_QUEUE_BYTES, TX_QUEUE_BYTES};
+    use tss_reel::pus::Services;
     use tss_reel::recordings::replay::{
         DROPOUT_FROM_TICK, DROPOUT_UNTIL_TICK, ORBIT_RATE_RADPS, PERIOD_S, SAMPLES,
     };
@@ -243,6 +279,130 @@ mod board {
         }
     }
 
+    /// Bytes the USART2 interrupt moves per call at most, each way: the 8-byte FIFO and the
+    /// shift register, twice (a bounded loop; what is left raises the interrupt again).
+    const USART_BYTES_PER_INTERRUPT: usize = 18;
+
+    /// Bytes of a telemetry frame the main loop queues per critical section: short enough not
+    /// to delay the inner step or the receiver noticeably.
+    const TX_CHUNK_BYTES: usize = 16;
+
+    /// USART2, split: the receiver and the transmitter.
+    struct Usart2 {
+        tx: serial::Tx<USART2, PA2<AF7>, NoDMA>,
+        rx: serial::Rx<USART2, PA3<AF7>, NoDMA>,
+    }
+
+    /// The line to the on-board computer: USART2 and its two queues. The USART2 interrupt
+    /// moves bytes between the hardware and the queues; the main loop reads and fills the
+    /// queues ([`ObcPort`]). Every access is in a critical section.
+    struct ObcLine {
+        /// The USART, once `main` has set it up.
+        usart: Option<Usart2>,
+        /// Received bytes, or the line error in their place, oldest first.
+        received: Deque<Result<u8, ErrorKind>, RX_QUEUE_BYTES>,
+        /// Telemetry frames' bytes waiting for the line, oldest first.
+        to_send: Deque<u8, TX_QUEUE_BYTES>,
+    }
+
+    /// Shared between the USART2 interrupt and the main loop (zero-initialised: `.bss`).
+    static OBC_LINE: Mutex<RefCell<ObcLine>> = Mutex::new(RefCell::new(ObcLine {
+        usart: None,
+        received: Deque::new(),
+        to_send: Deque::new(),
+    }));
+
+    impl ObcLine {
+        /// The interrupt's work: the receive FIFO into [`Self::received`], then
+        /// [`Self::to_send`] into the transmit FIFO (its interrupt off once the queue is empty).
+        fn move_bytes(&mut self) {
+            let Some(usart) = self.usart.as_mut() else {
+                return;
+            };
+            for _ in 0..USART_BYTES_PER_INTERRUPT {
+                let item = match usart.rx.read() {
+                    Ok(byte) => Ok(byte),
+                    Err(nb::Error::WouldBlock) => break,
+                    Err(nb::Error::Other(serial::Error::Overrun)) => Err(ErrorKind::Overrun),
+                    // Framing, noise, parity: the damaged byte follows in the next read.
+                    Err(nb::Error::Other(_)) => Err(ErrorKind::Framing),
+                };
+                if self.received.push_back(item).is_err() {
+                    // The queue is full: this byte is lost, and the newest kept one becomes
+                    // the overrun that stands for the loss.
+                    if let Some(newest) = self.received.back_mut() {
+                        *newest = Err(ErrorKind::Overrun);
+                    }
+                }
+            }
+            for _ in 0..USART_BYTES_PER_INTERRUPT {
+                let Some(&byte) = self.to_send.front() else {
+                    usart.tx.unlisten();
+                    break;
+                };
+                if usart.tx.write(byte).is_err() {
+                    break; // FIFO full: the interrupt comes back when it is not
+                }
+                let _ = self.to_send.pop_front();
+            }
+        }
+    }
+
+    /// The main loop's end of the line to the on-board computer: [`BytePort`] over
+    /// [`ObcLine`]'s queues.
+    pub struct ObcPort;
+
+    impl ErrorType for ObcPort {
+        type Error = ErrorKind;
+    }
+
+    impl BytePort for ObcPort {
+        fn read_byte(&mut self) -> Result<Option<u8>, ErrorKind> {
+            cortex_m::interrupt::free(|cs| {
+                // As in `SysTick`: the borrow cannot fail (critical section, one core).
+                let mut line = OBC_LINE
+                    .borrow(cs)
+                    .try_borrow_mut()
+                    .map_err(|_| ErrorKind::Other)?;
+                line.received.pop_front().transpose()
+            })
+        }
+
+        fn send(&mut self, bytes: &[u8]) -> Result<(), ErrorKind> {
+            // Only the main loop fills the queue and the interrupt only empties it, so room
+            // seen here is still there for the chunks below.
+            cortex_m::interrupt::free(|cs| {
+                let line = OBC_LINE
+                    .borrow(cs)
+                    .try_borrow()
+                    .map_err(|_| ErrorKind::Other)?;
+                let room = line.to_send.capacity() - line.to_send.len();
+                match line.usart {
+                    None => Err(ErrorKind::Other),
+                    Some(_) if room < bytes.len() => Err(ErrorKind::Full),
+                    Some(_) => Ok(()),
+                }
+            })?;
+            for chunk in bytes.chunks(TX_CHUNK_BYTES) {
+                cortex_m::interrupt::free(|cs| {
+                    let mut line = OBC_LINE
+                        .borrow(cs)
+                        .try_borrow_mut()
+                        .map_err(|_| ErrorKind::Other)?;
+                    let line = &mut *line;
+                    for &b in chunk {
+                        line.to_send.push_back(b).map_err(|_| ErrorKind::Full)?;
+                    }
+                    if let Some(usart) = line.usart.as_mut() {
+                        usart.tx.listen();
+                    }
+                    Ok(())
+                })?;
+            }
+            Ok(())
+        }
+    }
+
     /// The outer loop's view of the reel: it keeps the law's latest command for the main loop
     /// to hand to the speed loop.
     struct CommandLatch {
@@ -264,17 +424,50 @@ mod board {
     struct Outer {
         controller: Controller<f32>,
         devices: Devices<Replay, Replay, Replay, CommandLatch, Replay>,
+        /// The unit's PUS services around the controller.
+        services: Services,
+        /// The on-board computer's link, reassembled and framed.
+        obc: PacketPort,
     }
 
     impl Outer {
-        /// One law period: read the sensors, step the controller, return its command.
+        /// One law period: the telecommands of the period that ended, then read the sensors,
+        /// step the controller, queue its telemetry, and return its command.
         ///
-        /// Out of line: the symbol `scripts/panic-check` starts from for this board.
+        /// Out of line: a symbol `scripts/panic-check` starts from for this board.
         #[inline(never)]
         fn control(&mut self, period: u32, drive: DriveFaults) -> Option<RateCommand> {
+            self.obc
+                .deliver(&mut ObcPort, &mut self.services, &mut self.controller);
             self.devices.reel.latest = None;
-            let _ = control_cycle(&mut self.controller, period, &mut self.devices, drive);
+            let cycle = control_cycle(&mut self.controller, period, &mut self.devices, drive);
+            self.obc.report(
+                &mut ObcPort,
+                &mut self.services,
+                &mut self.controller,
+                cycle.input.as_ref(),
+            );
             self.devices.reel.latest
+        }
+
+        /// A law period after the replay: no step, but the telecommands are still verified
+        /// and the housekeeping (of the last step) still sent.
+        ///
+        /// Out of line: a symbol `scripts/panic-check` starts from for this board.
+        #[inline(never)]
+        fn idle(&mut self) {
+            self.obc
+                .deliver(&mut ObcPort, &mut self.services, &mut self.controller);
+            self.obc
+                .report(&mut ObcPort, &mut self.services, &mut self.controller, None);
+        }
+
+        /// Between law periods: what the on-board computer sent, into the port.
+        ///
+        /// Out of line: a symbol `scripts/panic-check` starts from for this board.
+        #[inline(never)]
+        fn listen(&mut self) {
+            self.obc.receive(&mut ObcPort);
         }
     }
 
@@ -302,6 +495,10 @@ mod board {
             env!("CARGO_PKG_VERSION"),
             INNER_RATE_HZ,
             OUTER_PERIOD_TICKS
+        );
+        defmt::info!(
+            "on-board computer link: USART2 (PA2 TX, PA3 RX), {=u32} Bd 8N1, PUS packets in link frames",
+            LINE_RATE_BAUD
         );
         let (Some(dp), Some(mut cp)) = (stm32::Peripherals::take(), cortex_m::Peripherals::take())
         else {
@@ -345,6 +542,33 @@ mod board {
             scale: LOAD_CELL,
         };
 
+        // The on-board computer's link: USART2 with its FIFOs, interrupts on a byte received
+        // (the transmit interrupt is turned on when there is telemetry to send).
+        let usart = match dp.USART2.usart(
+            gpioa.pa2.into_alternate(),
+            gpioa.pa3.into_alternate(),
+            FullConfig::default()
+                .baudrate(LINE_RATE_BAUD.bps())
+                .fifo_enable(),
+            &mut rcc,
+        ) {
+            Ok(u) => u,
+            Err(_) => defmt::panic!("USART2 cannot make {=u32} Bd", LINE_RATE_BAUD),
+        };
+        let (tx, mut rx) = usart.split();
+        rx.listen();
+        cortex_m::interrupt::free(|cs| {
+            if let Ok(mut line) = OBC_LINE.borrow(cs).try_borrow_mut() {
+                line.usart = Some(Usart2 { tx, rx });
+            }
+        });
+        #[allow(unsafe_code)]
+        // SAFETY: the USART2 handler shares its data with the main loop only through
+        // `OBC_LINE`, in critical sections; unmasking it breaks no critical section.
+        unsafe {
+            NVIC::unmask(Interrupt::USART2);
+        }
+
         // The speed loop: the reference drive's parameters, this board's rate and counter.
         let mut cfg = DriveConfig::example();
         cfg.inner_rate_hz = INNER_RATE_HZ;
@@ -378,6 +602,8 @@ mod board {
                 reel: CommandLatch { latest: None },
                 tension: Replay,
             },
+            services: Services::new(),
+            obc: PacketPort::new(),
         };
 
         // The inner loop starts: SysTick on the core clock. It outranks nothing else here; the
@@ -404,10 +630,13 @@ mod board {
         let start = INNER_TICKS.load(Ordering::Acquire);
         let mut period: u32 = 0;
         let mut outer_overruns: u32 = 0;
+        let mut link_losses: u32 = 0;
         loop {
-            // Sleep until the law period `period` is due (SysTick wakes us every inner tick).
+            // Sleep until the law period `period` is due (SysTick wakes us every inner tick,
+            // USART2 at every byte), taking in what the on-board computer sends meanwhile.
             let due = period.saturating_mul(OUTER_PERIOD_TICKS);
             let elapsed = loop {
+                outer.listen();
                 let e = INNER_TICKS.load(Ordering::Acquire).wrapping_sub(start);
                 if e >= due {
                     break e;
@@ -431,12 +660,13 @@ mod board {
                     .map(|i| core::mem::replace(&mut i.period_faults, DriveFaults::NONE))
             })
             .unwrap_or(DriveFaults::NONE);
-            let cmd = if (period as usize) < SAMPLES.len() {
-                outer.control(period, drive_faults)
-            } else {
-                None
-            };
             let finished = period as usize >= SAMPLES.len();
+            let cmd = if finished {
+                outer.idle();
+                None
+            } else {
+                outer.control(period, drive_faults)
+            };
             let hold = RateCommand {
                 rate_mps: 0.0,
                 accel_mps2: 0.0,
@@ -451,20 +681,23 @@ mod board {
                 })
             });
 
-            let mut events = false;
-            while let Some(ev) = outer.controller.pop_event() {
-                defmt::warn!("t={=u32} event: {}", ev.tick, ev.kind);
-                events = true;
+            // The controller's events went to the on-board computer (TM[5,x]); what the link
+            // lost or refused is logged here when it grows.
+            let link = outer.obc.counters();
+            let losses = link.losses();
+            if losses != link_losses {
+                defmt::warn!("t={=u32} on-board computer link: {}", period, link);
+                link_losses = losses;
             }
             if finished {
                 if period as usize == SAMPLES.len() {
                     defmt::info!("replay done: drive in safe hold");
                 }
-            } else if events || period.is_multiple_of(LOG_EVERY_PERIODS) {
+            } else if period.is_multiple_of(LOG_EVERY_PERIODS) {
                 let o = outer.controller.output();
                 if let Some(d) = out {
                     defmt::info!(
-                        "t={=u32} {} {}: cmd={=f32} m/s drum={=f32} m/s ref={=f32} m/s duty={=f32} T={=f32} N brake={} faults={} overruns inner={=u32} outer={=u32}",
+                        "t={=u32} {} {}: cmd={=f32} m/s drum={=f32} m/s ref={=f32} m/s duty={=f32} T={=f32} N brake={} faults={} overruns inner={=u32} outer={=u32} tc={=u32} tm={=u32}",
                         period,
                         o.phase,
                         o.health,
@@ -476,7 +709,9 @@ mod board {
                         d.brake,
                         d.faults,
                         INNER_OVERRUNS.load(Ordering::Relaxed),
-                        outer_overruns
+                        outer_overruns,
+                        link.telecommands,
+                        link.telemetry_sent
                     );
                 }
             }
@@ -510,6 +745,17 @@ mod board {
         if SCB::is_pendst_pending() {
             INNER_OVERRUNS.fetch_add(1, Ordering::Relaxed);
         }
+    }
+
+    /// The on-board computer's line: bytes between USART2's FIFOs and [`ObcLine`]'s queues.
+    #[interrupt]
+    fn USART2() {
+        cortex_m::interrupt::free(|cs| {
+            // As in `SysTick`: the borrow cannot fail (critical section, one core).
+            if let Ok(mut line) = OBC_LINE.borrow(cs).try_borrow_mut() {
+                line.move_bytes();
+            }
+        });
     }
 
     /// Any fault (a panic reaches here through panic-probe's `udf`): log, and reset into the
