@@ -46,9 +46,9 @@ pub const RECEIVE_BUDGET_BYTES: usize = 4 * MAX_WIRE_LEN;
 
 /// The line rate a board runs the port at, bit/s (8N1: 10 bits a byte, 11 520 bytes/s): the
 /// ST-LINK virtual COM port's usual rate. A worst period's telemetry (every telecommand a
-/// period takes completed, every flood report, a full event queue, housekeeping) is under a
-/// seventh of a second of it: `tests/pus_port.rs` measures it
-/// (`the_worst_period_fits_the_transmit_queue_and_the_line`).
+/// period takes completed, every flood report, a full event queue, housekeeping) takes under
+/// a quarter of the 1 s law period on it, so the line is idle most of the time even then:
+/// `tests/pus_port.rs` measures it (`the_worst_period_fits_the_transmit_queue_and_the_line`).
 pub const LINE_RATE_BAUD: u32 = 115_200;
 
 /// The transmit queue a board gives the port, bytes: a worst period's telemetry, with room
