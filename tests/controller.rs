@@ -2,7 +2,8 @@
 //! (Nominal → Degraded → SafeHold → Nominal), the sensor checks and the sequencer.
 
 use tss_reel::controller::{
-    Config, Controller, Fault, Flags, Health, Input, Output, Phase, Rule, Sensor,
+    Config, Controller, Fault, Flags, Health, Input, ModeCommand, Output, Phase, Rule, Sensor,
+    TensionLoopConfig,
 };
 use tss_reel::law::LawFault;
 
@@ -1001,4 +1002,129 @@ fn a_libration_beyond_the_laws_domain_is_safe_hold_at_once() {
         ..sample(0, 100.0)
     };
     assert_ne!(ctl.step(&x).fault, Some(Fault::Libration));
+}
+
+/// The paper's controller with the tension loop on the deployment plateau, the length
+/// following its command, a load cell reading a bounce of 0.5 N (31-s period) on a 5-N free
+/// tension less the tension the last command's acceleration takes away (Eq. 5a, m_r ≈ 99 kg;
+/// 0 when slack).
+struct Plateau {
+    ctl: Controller<f32>,
+    length_m: f32,
+}
+
+impl Plateau {
+    fn new() -> Self {
+        let cfg = Config {
+            tension_loop: Some(TensionLoopConfig::dyneema_half_mm()),
+            ..Config::paper()
+        };
+        Self {
+            ctl: Controller::new(cfg).unwrap(),
+            length_m: 10_000.0,
+        }
+    }
+
+    /// A step at `tick`; the load cell NaN unless `load_cell`, α̇ missing unless `rate_sensor`.
+    fn step(&mut self, tick: u32, load_cell: bool, rate_sensor: bool) -> Output<f32> {
+        let last = *self.ctl.output();
+        self.length_m += last.rate_cmd_mps;
+        let tension_n =
+            (5.0 + 0.5 * (0.2 * tick as f32).sin() - 99.0 * last.accel_cmd_mps2).max(0.0);
+        *self.ctl.step(&Input {
+            tension_n: Some(if load_cell { tension_n } else { f32::NAN }),
+            alpha_rate_radps: rate_sensor.then_some(0.0),
+            ..sample(tick, self.length_m)
+        })
+    }
+
+    fn fly(&mut self, ticks: core::ops::Range<u32>) {
+        for tick in ticks {
+            self.step(tick, true, true);
+        }
+    }
+}
+
+/// A safe action brings the reel to rest with the tension loop's admittance term added only on
+/// a sample the monitor accepted and a load cell the loop tracks (docs/equations.md §17.8):
+/// a safe hold on rejected samples, and a stop with the load cell lost, are the plain ramp to
+/// the bit; a safe hold awaiting recovery and an abort, with the load cell tracked, damp.
+#[test]
+fn a_safe_action_uses_the_load_cell_only_on_an_accepted_sample_it_tracks() {
+    let plain = |v: f32| v - v.clamp(-0.01, 0.01);
+
+    // The swing's rate sensor fails: the health machine coasts, then holds safe, on rejected
+    // samples whose load cell still reads the bounce: the plain ramp (or the coast).
+    let mut p = Plateau::new();
+    p.fly(0..60);
+    assert_eq!(p.ctl.output().health, Health::Nominal);
+    let mut previous = p.ctl.output().rate_cmd_mps;
+    let mut held = 0;
+    for tick in 60..1_500 {
+        let out = p.step(tick, true, false);
+        assert_eq!(out.fault, Some(Fault::Sensor(Sensor::AlphaRate)));
+        match out.health {
+            Health::SafeHold => {
+                assert_eq!(out.rate_cmd_mps, plain(previous), "{tick}");
+                held += 1;
+            }
+            _ => assert_eq!(out.rate_cmd_mps, previous, "{tick}"),
+        }
+        previous = out.rate_cmd_mps;
+    }
+    assert!(held > 30 && previous == 0.0, "{held}: at rest, {previous}");
+    // Back, the samples accepted while the safe hold awaits recovery: the term damps the bounce.
+    let mut damped = 0;
+    for tick in 1_500..1_505 {
+        let out = p.step(tick, true, true);
+        assert_eq!(out.health, Health::SafeHold);
+        damped += usize::from(out.rate_cmd_mps != plain(previous));
+        assert!(
+            out.rate_cmd_mps.abs() <= 0.01,
+            "the term's authority: {out:?}"
+        );
+        previous = out.rate_cmd_mps;
+    }
+    assert!(damped > 0);
+
+    // The load cell lost (NaN for longer than the timeout), then an abort: the plain ramp.
+    let mut p = Plateau::new();
+    p.fly(0..60);
+    for tick in 60..70 {
+        p.step(tick, false, true);
+    }
+    assert!(p.ctl.output().flags.contains(Flags::LOAD_CELL_LOST));
+    p.ctl.command(ModeCommand::Abort).unwrap();
+    let mut previous = p.ctl.output().rate_cmd_mps;
+    assert!(
+        previous.abs() > 0.02,
+        "{previous}: a ramp of several periods"
+    );
+    for tick in 70..100 {
+        let out = p.step(tick, false, true);
+        assert!(out.flags.contains(Flags::ABORTED | Flags::SAFE_ACTION));
+        assert_eq!(out.rate_cmd_mps, plain(previous), "{tick}");
+        previous = out.rate_cmd_mps;
+    }
+
+    // Tracked, the abort's stop damps the bounce, and comes to rest on average.
+    let mut p = Plateau::new();
+    p.fly(0..70);
+    p.ctl.command(ModeCommand::Abort).unwrap();
+    let mut previous = p.ctl.output().rate_cmd_mps;
+    let mut damped = 0;
+    let mut rest_m = None;
+    for tick in 70..2_000 {
+        let out = p.step(tick, true, true);
+        damped += usize::from(out.rate_cmd_mps != plain(previous));
+        previous = out.rate_cmd_mps;
+        if tick == 1_000 {
+            rest_m = Some(p.length_m);
+        }
+    }
+    assert!(damped > 1_000, "{damped}");
+    // The term's length over 1 000 s at rest: K τ_w times the change of the washout's mean
+    // (17.10), a bounce's worth at most: K(10 km) ≈ 0.12 m/s/N, τ_w = 100 s, 0.5 N.
+    let moved_m = p.length_m - rest_m.unwrap();
+    assert!(moved_m.abs() < 0.12 * 100.0 * 0.5, "{moved_m}");
 }

@@ -115,7 +115,7 @@ use events::EventQueue;
 use health::{DeadReckoning, HealthMachine};
 use protection::{FreeTensionModel, Protection};
 use sequencer::Sequencer;
-use tension::{StageInput, TensionStage};
+use tension::{RestInput, StageInput, TensionStage};
 
 pub use tension::TensionLoopMode;
 
@@ -451,7 +451,9 @@ impl<T: Real> Controller<T> {
         };
         let reference = match self.sequence(tick, &sensed) {
             Sequenced::Law(reference) => reference,
-            Sequenced::Held { alpha_ref_rad } => return self.hold(tick, true, alpha_ref_rad, None),
+            Sequenced::Held { alpha_ref_rad } => {
+                return self.hold(tick, true, Some(sensed.input), alpha_ref_rad, None)
+            }
         };
         let solved = match self.law(tick, &sensed, &reference) {
             Ok(solved) => solved,
@@ -786,7 +788,7 @@ impl<T: Real> Controller<T> {
             let l = self.length.length_m().unwrap_or(T::ZERO);
             self.sequencer.reference(tick, l).angle.angle_rad
         });
-        self.hold(tick, true, alpha_ref_rad, Some(unusable.fault))
+        self.hold(tick, true, None, alpha_ref_rad, Some(unusable.fault))
     }
 
     /// A sample whose tick did not move forward: a bad sample for the health machine, at a
@@ -800,33 +802,53 @@ impl<T: Real> Controller<T> {
         let now = self.clock.last_tick().unwrap_or(tick);
         let l = self.length.length_m().unwrap_or(T::ZERO);
         let alpha_ref_rad = self.sequencer.reference(now, l).angle.angle_rad;
-        self.hold(now, false, alpha_ref_rad, Some(fault))
+        self.hold(now, false, None, alpha_ref_rad, Some(fault))
     }
 
     /// The safe actions at `now` (`time_moved`: to `now`; otherwise `now` is the last accepted
     /// tick). Degraded: keep the last command (coast). Safe hold, and a hold by command in any
     /// health: ramp the rate to zero at `monitor.safe_hold_decel_mps2` (at most the envelope's
-    /// limit). When time did not move,
-    /// the command stays. All stay inside the length limits, judged on the estimated length
-    /// (before any accepted sample, on the docking end: 0 m).
+    /// limit), on a sample the monitor `accepted` with the tension loop's admittance term added,
+    /// which damps the tether's bounce the stop excites (docs/equations.md §17.8). When time
+    /// did not move, the command stays. All stay inside the length limits, judged on the
+    /// estimated length (before any accepted sample, on the docking end: 0 m).
     fn hold(
         &mut self,
         now: u32,
         time_moved: bool,
+        accepted: Option<&Input<T>>,
         alpha_ref_rad: T,
         fault: Option<Fault>,
     ) -> Decided<T> {
         let dt = self.cfg.period_s;
         let previous = self.last_command.rate_mps;
-        if let Some(t) = &mut self.tension {
-            t.skipped();
-        }
         let mode = self.sequencer.mode();
-        let target = match (time_moved, self.health.health(), mode.holds()) {
-            (false, _, _) | (true, Health::Degraded, false) => previous,
-            (true, Health::Nominal | Health::SafeHold, _) | (true, Health::Degraded, true) => {
-                let step = self.safe_hold_step_mps;
-                previous - previous.clamp_finite(-step, step)
+        let ramps = match (time_moved, self.health.health(), mode.holds()) {
+            (false, _, _) | (true, Health::Degraded, false) => false,
+            (true, Health::Nominal | Health::SafeHold, _) | (true, Health::Degraded, true) => true,
+        };
+        let step = self.safe_hold_step_mps;
+        let target = match (&mut self.tension, accepted.filter(|_| ramps)) {
+            (Some(t), Some(x)) => {
+                let (target, mode_changed) = t.bring_to_rest(&RestInput {
+                    previous_mps: previous,
+                    step_mps: step,
+                    length_m: x.length_m,
+                    tension_n: x.tension_n,
+                });
+                self.events
+                    .record(now, mode_changed.map(EventKind::TensionLoop));
+                target
+            }
+            (tension, _) => {
+                if let Some(t) = tension {
+                    t.skipped();
+                }
+                if ramps {
+                    previous - previous.clamp_finite(-step, step)
+                } else {
+                    previous
+                }
             }
         };
         let length_m = self.length.length_m().unwrap_or(T::ZERO);

@@ -76,6 +76,19 @@ pub(crate) struct StageInput<T> {
     pub(crate) tension_n: Option<T>,
 }
 
+/// What a safe action that brings the reel to rest needs from the step.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RestInput<T> {
+    /// The last command sent, m/s.
+    pub(crate) previous_mps: T,
+    /// The safe action's largest change of rate in one period, m/s.
+    pub(crate) step_mps: T,
+    /// l, m.
+    pub(crate) length_m: T,
+    /// The load cell's sample of this step, N.
+    pub(crate) tension_n: Option<T>,
+}
+
 /// What the stage decided.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct StageOutput<T> {
@@ -117,6 +130,21 @@ impl<T: Real> AtMass<T> {
             ),
         }
     }
+}
+
+/// The least braking a safe action keeps while the tension window (17.8) would allow less, as a
+/// share of its ramp's (docs/equations.md §17.8): a slack or nearly slack tether still lets the
+/// reel come to rest, within 1/share times the plain ramp's periods.
+pub const LEAST_BRAKING_SHARE: f64 = 0.25;
+
+/// The window (17.8) of the washout `w` with this period's band-passed free tension `bounce_n`:
+/// judged on the mean and on this period's free tension, whichever is the worse for the motion
+/// (the mean lags a free tension that changes, as in the slew).
+fn window_of<T: Real>(window: &TensionWindow<T>, w: &Washout<T>, bounce_n: T) -> (T, T) {
+    window.of(
+        w.mean_n + bounce_n.min(T::ZERO),
+        w.mean_n + bounce_n.max(T::ZERO),
+    )
 }
 
 /// The tension loop's state.
@@ -206,25 +234,68 @@ impl<T: Real> TensionStage<T> {
         self.last_shaped_accel_mps2 = T::ZERO;
     }
 
-    /// One step of the law: the command to request of the envelope.
-    pub(crate) fn step(&mut self, x: &StageInput<T>) -> StageOutput<T> {
-        let dt = self.period_s;
-        let at_mass = match self.fixed_mass {
+    /// A step of a safe action that brings the reel to rest, on a sample the monitor accepted
+    /// (docs/equations.md §17.8): the safe action's ramp toward rest of the last command less
+    /// its admittance part (so the ramp comes to rest whatever the term did), each step at most
+    /// `x.step_mps` and, while the loop tracks the load cell, no steeper than the tension window
+    /// (17.8) allows but at least [`LEAST_BRAKING_SHARE`] of `x.step_mps`, plus the admittance
+    /// term (17.3), at most `x.step_mps` either way (17.9). Without a tracked load cell: the plain ramp. Returns the rate to
+    /// request of the limits, m/s, and the loop's mode if it changed at this step (an event).
+    pub(crate) fn bring_to_rest(&mut self, x: &RestInput<T>) -> (T, Option<TensionLoopMode>) {
+        let at_mass = self.at_mass(x.length_m);
+        let before = self.load_cell.mode();
+        let bounce_n = self.read_load_cell(x.tension_n, at_mass.radial_kg);
+        let (brake_pay_out_mps, brake_wind_in_mps) = match &self.load_cell {
+            LoadCell::Tracking(w) => {
+                let (a_lo, a_hi) = window_of(&at_mass.window, w, bounce_n);
+                let dt = self.period_s;
+                let least = x.step_mps * T::from_f64(LEAST_BRAKING_SHARE);
+                // (a_lo ≤ 0 ≤ a_hi, finite: the window of a plausible sample's washout.)
+                (
+                    (-a_lo * dt).clamp_finite(least, x.step_mps),
+                    (a_hi * dt).clamp_finite(least, x.step_mps),
+                )
+            }
+            LoadCell::Waiting | LoadCell::Coasting { .. } | LoadCell::Lost => {
+                (x.step_mps, x.step_mps)
+            }
+        };
+        let anchor_mps = x.previous_mps - self.last_admittance_mps;
+        let ramp_mps = anchor_mps - anchor_mps.clamp_finite(-brake_wind_in_mps, brake_pay_out_mps);
+        self.last_shaped_accel_mps2 = (ramp_mps - anchor_mps) / self.period_s;
+        // The term's authority in a safe action: the ramp's own change in one period (the
+        // product of a plausible sample's washout and a finite gain is finite).
+        let admittance_mps =
+            (at_mass.gain.at(x.length_m) * bounce_n).clamp_finite(-x.step_mps, x.step_mps);
+        self.last_admittance_mps = admittance_mps;
+        let after = self.load_cell.mode();
+        (
+            ramp_mps + admittance_mps,
+            (after != before).then_some(after),
+        )
+    }
+
+    /// The loop's laws at the reduced mass of the length `length_m`.
+    fn at_mass(&self, length_m: T) -> AtMass<T> {
+        match self.fixed_mass {
             Some(m) => m,
             None => AtMass::new(
                 &self.cfg,
-                self.masses.coefficients(x.length_m).radial_kg,
-                dt,
+                self.masses.coefficients(length_m).radial_kg,
+                self.period_s,
             ),
-        };
-        let radial_kg = at_mass.radial_kg;
-        let before = self.load_cell.mode();
+        }
+    }
 
-        // The load cell: the free tension it measures (17.3), its mean and its bounce.
+    /// The load cell's sample `tension_n` of this step (17.3), with the reduced mass
+    /// `radial_kg`: the washout of the free tension it measures, and the mode that follows
+    /// (§17.6). Returns the band-passed free tension the admittance term acts on, N (0 without
+    /// a sample to act on).
+    fn read_load_cell(&mut self, tension_n: Option<T>, radial_kg: T) -> T {
         // (One comparison: false for NaN and the infinities too.)
         let plausible = T::from_f64(MAX_PLAUSIBLE_TENSION_N);
-        let sample = x.tension_n.filter(|t| t.abs() <= plausible);
-        let bounce_n = match (sample, &mut self.load_cell) {
+        let sample = tension_n.filter(|t| t.abs() <= plausible);
+        match (sample, &mut self.load_cell) {
             (Some(t), LoadCell::Tracking(w) | LoadCell::Coasting { washout: w, .. }) => {
                 let mut w = *w;
                 let free_n = t + radial_kg * self.last_shaped_accel_mps2;
@@ -256,17 +327,24 @@ impl<T: Real> TensionStage<T> {
                 T::ZERO
             }
             (None, LoadCell::Waiting | LoadCell::Lost) => T::ZERO,
-        };
+        }
+    }
+
+    /// One step of the law: the command to request of the envelope.
+    pub(crate) fn step(&mut self, x: &StageInput<T>) -> StageOutput<T> {
+        let dt = self.period_s;
+        let at_mass = self.at_mass(x.length_m);
+        let before = self.load_cell.mode();
+
+        // The load cell: the free tension it measures (17.3), its mean and its bounce.
+        let bounce_n = self.read_load_cell(x.tension_n, at_mass.radial_kg);
 
         // The window (17.8), widened by the attitude's share (§17.5).
         let c = &self.cfg;
         let (a_lo, a_hi) = match &self.load_cell {
-            // Judged on the mean and on this period's free tension, whichever is the worse for
-            // the motion (the mean lags a free tension that changes, as in the slew).
-            LoadCell::Tracking(w) | LoadCell::Coasting { washout: w, .. } => at_mass.window.of(
-                w.mean_n + bounce_n.min(T::ZERO),
-                w.mean_n + bounce_n.max(T::ZERO),
-            ),
+            LoadCell::Tracking(w) | LoadCell::Coasting { washout: w, .. } => {
+                window_of(&at_mass.window, w, bounce_n)
+            }
             LoadCell::Waiting | LoadCell::Lost => (-c.fallback_accel_mps2, c.fallback_accel_mps2),
         };
         let share = self.share.at(x.delta_rad);
@@ -463,5 +541,84 @@ mod tests {
             assert!(out.rate_mps.is_finite(), "{k}: {out:?}");
             previous = out.rate_mps;
         }
+    }
+
+    fn rest(previous_mps: f64, tension_n: Option<f64>) -> RestInput<f64> {
+        RestInput {
+            previous_mps,
+            step_mps: 0.01,
+            length_m: 2_400.0,
+            tension_n,
+        }
+    }
+
+    /// Bringing a wind-in to rest on a tracked load cell (§17.8): the braking no steeper than the
+    /// window lets the free tension carry (0.73 N at 2.4 km: 0.0047 m/s², not the ramp's 0.01),
+    /// never below a quarter of the ramp's, the tension it takes away added back to the free
+    /// tension; at rest, only the admittance term of a bounce.
+    #[test]
+    fn a_stop_on_a_tracked_load_cell_brakes_within_the_window_then_damps() {
+        let mut s = stage();
+        let m_r = MassModel::<f64>::paper().coefficients(0.0).radial_kg;
+        let t = 0.73;
+        let _ = s.step(&input(-0.36, -0.36, Some(t)));
+        let mut previous = -0.36;
+        let a_hi = (t - 0.1) / (1.5 * m_r);
+        let mut accel = 0.0;
+        let mut ticks = 0;
+        while previous.abs() > 1e-4 {
+            // The load cell reads the free tension less what the last braking took away.
+            let (rate, mode) = s.bring_to_rest(&rest(previous, Some(t - m_r * accel)));
+            assert_eq!(mode, None);
+            accel = rate - previous;
+            assert!(accel > 0.0 && accel <= 1.001 * a_hi, "{ticks}: {accel}");
+            assert!(rate <= 1e-4, "{ticks}: no overshoot into a pay-out");
+            previous = rate;
+            ticks += 1;
+            assert!(ticks < 100, "at rest within 0.36/a_hi periods");
+        }
+        assert!(
+            (f64::from(ticks) - (0.36 / a_hi).ceil()).abs() <= 1.0,
+            "{ticks}"
+        );
+        // At rest, a bounce: the command is K times its band-passed part, around 0.
+        let gain = admittance_gain_mps_per_n(2_400.0, 1e4, m_r, 0.6, 1.0);
+        let (rate, _) = s.bring_to_rest(&rest(0.0, Some(t + 1.0)));
+        assert!(rate > 0.0 && rate <= gain * 1.0, "a pull pays out: {rate}");
+        let (back, _) = s.bring_to_rest(&rest(rate, Some(t)));
+        assert!(back.abs() < rate, "{back}");
+        // A slack tether (the window closed): still a quarter of the ramp's braking.
+        let mut s = stage();
+        let _ = s.step(&input(-0.36, -0.36, Some(0.0)));
+        let (rate, _) = s.bring_to_rest(&rest(-0.36, Some(0.0)));
+        assert!(
+            (rate - (-0.36 + LEAST_BRAKING_SHARE * 0.01)).abs() < 1e-12,
+            "{rate}"
+        );
+    }
+
+    /// A load cell the loop does not track (never read, lost, or an implausible sample) is not
+    /// used by a safe action: the plain ramp of the last command, to the bit.
+    #[test]
+    fn a_stop_without_a_tracked_load_cell_is_the_plain_ramp() {
+        let plain = |v: f64| v - v.clamp(-0.01, 0.01);
+        // Waiting: none read yet.
+        let mut s = stage();
+        assert_eq!(s.bring_to_rest(&rest(-0.36, None)).0, plain(-0.36));
+        // Lost after the timeout; a wild sample, NaN, ±∞: still the plain ramp.
+        let mut s = stage();
+        let _ = s.step(&input(-0.36, -0.36, Some(0.73)));
+        let mut previous = -0.36;
+        for _ in 0..6 {
+            previous = s.step(&input(-0.36, previous, None)).rate_mps;
+        }
+        assert_eq!(s.mode(), TensionLoopMode::Lost);
+        for t in [None, Some(f64::NAN), Some(f64::INFINITY), Some(-1e6)] {
+            let (rate, mode) = s.bring_to_rest(&rest(previous, t));
+            assert_eq!(rate, plain(previous), "{t:?}");
+            assert_eq!(mode, None);
+            previous = rate;
+        }
+        assert_eq!(s.mode(), TensionLoopMode::Lost);
     }
 }
