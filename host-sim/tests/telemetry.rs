@@ -51,11 +51,11 @@ const RESUME_S: f64 = 21_600.0;
 
 /// How a controller keeps the reel at rest: exactly (no tension loop: l̇ = 0), or with the
 /// tension loop's admittance term still damping the tether (docs/equations.md §17.8).
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 enum Rest {
     Exact,
     /// The loop of this configuration (K(l) of (17.5)–(17.6), τ_w).
-    Compliant(Config<f64>),
+    Compliant(Box<Config<f64>>),
 }
 
 impl Rest {
@@ -63,14 +63,14 @@ impl Rest {
         let cfg = sc.controller_config::<f64>();
         match cfg.tension_loop {
             None => Rest::Exact,
-            Some(_) => Rest::Compliant(cfg),
+            Some(_) => Rest::Compliant(Box::new(cfg)),
         }
     }
 
     /// The reel at rest over `samples` (from the first one on): with the loop, the admittance
     /// term K·HP[x] moves it by at most K times the spread of the free tension x (the tension
     /// at rest) in rate, and by K·τ_w times that spread in length (17.10); exactly none without.
-    fn assert_at_rest(self, samples: &[&Sample]) {
+    fn assert_at_rest(&self, samples: &[&Sample]) {
         let spread_n = match self {
             Rest::Exact => 0.0,
             Rest::Compliant(_) => {
@@ -110,7 +110,7 @@ impl Rest {
 /// A hold at 5 h: the reel at rest within `rest_s` and the length kept until the resume at
 /// 6 h, held and flagged throughout; then the law again (no safe action); stage 2 one hour
 /// late, at 9 h.
-fn assert_held_and_resumed(h: &History, rest: Rest, rest_s: f64) {
+fn assert_held_and_resumed(h: &History, rest: &Rest, rest_s: f64) {
     let held: Vec<&Sample> = between(h, HOLD_S + rest_s, RESUME_S - 10.0).collect();
     assert!(held.len() > 300);
     rest.assert_at_rest(&held);
@@ -133,7 +133,7 @@ fn the_paper_mission_holds_resumes_and_refuses_a_resume_it_cannot_take() {
     let (sc, h) = fly("paper-commanded");
     // −0.013 m/s at 5 h, ramped down at 0.01 m/s² (monitor.safe_hold_decel_mps2): at rest
     // from the second period of the hold, exactly (no tension loop).
-    assert_held_and_resumed(&h, Rest::of(&sc), 10.0);
+    assert_held_and_resumed(&h, &Rest::of(&sc), 10.0);
     assert_eq!(
         verification(&h),
         [
@@ -155,7 +155,7 @@ fn the_elastic_mission_holds_resumes_and_aborts_to_rest_taut() {
     let (sc, h) = fly("paper-elastic-commanded");
     let rest = Rest::of(&sc);
     assert!(matches!(rest, Rest::Compliant(_)));
-    assert_held_and_resumed(&h, rest, 100.0);
+    assert_held_and_resumed(&h, &rest, 100.0);
     // The abort at 11 h, retrieving at 0.36 m/s at 2.4 km: braked no faster than the tension
     // window allows (0.73 N of free tension carries 0.0047 m/s², not the ramp's 0.01) but at
     // least a quarter of the ramp's 0.01 m/s², so at rest within 4 × 36 s; then kept.

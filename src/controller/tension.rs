@@ -581,12 +581,21 @@ mod tests {
             (f64::from(ticks) - (0.36 / a_hi).ceil()).abs() <= 1.0,
             "{ticks}"
         );
-        // At rest, a bounce: the command is K times its band-passed part, around 0.
+        // At rest, a bounce: the command is K times its band-passed part, around 0; at most the
+        // ramp's own change in one period.
         let gain = admittance_gain_mps_per_n(2_400.0, 1e4, m_r, 0.6, 1.0);
-        let (rate, _) = s.bring_to_rest(&rest(0.0, Some(t + 1.0)));
-        assert!(rate > 0.0 && rate <= gain * 1.0, "a pull pays out: {rate}");
+        for _ in 0..3 {
+            previous = s.bring_to_rest(&rest(previous, Some(t))).0;
+        }
+        let (rate, _) = s.bring_to_rest(&rest(previous, Some(t + 0.1)));
+        assert!(
+            rate > previous && rate - previous <= gain * 0.1,
+            "a pull pays out: {previous} → {rate}"
+        );
         let (back, _) = s.bring_to_rest(&rest(rate, Some(t)));
-        assert!(back.abs() < rate, "{back}");
+        assert!(back < rate, "{back}");
+        let (rate, _) = s.bring_to_rest(&rest(back, Some(t + 10.0)));
+        assert_eq!(rate, 0.01, "a 10-N pull: the term's authority");
         // A slack tether (the window closed): still a quarter of the ramp's braking.
         let mut s = stage();
         let _ = s.step(&input(-0.36, -0.36, Some(0.0)));
