@@ -62,7 +62,7 @@ impl<T> LoadCell<T> {
 /// What the stage needs from the step.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct StageInput<T> {
-    /// The law's rate (Eqs. 27, 29), m/s.
+    /// The law's rate (Eqs. 27, 29), m/s: finite (`law::solve` faults otherwise).
     pub(crate) law_rate_mps: T,
     /// Its acceleration (Eq. 30), m/s².
     pub(crate) law_accel_mps2: T,
@@ -141,10 +141,13 @@ pub const LEAST_BRAKING_SHARE: f64 = 0.25;
 /// judged on the mean and on this period's free tension, whichever is the worse for the motion
 /// (the mean lags a free tension that changes, as in the slew).
 fn window_of<T: Real>(window: &TensionWindow<T>, w: &Washout<T>, bounce_n: T) -> (T, T) {
-    window.of(
-        w.mean_n + bounce_n.min(T::ZERO),
-        w.mean_n + bounce_n.max(T::ZERO),
-    )
+    let this_period_n = w.mean_n + bounce_n;
+    // (The band-passed part of a plausible sample is finite: one comparison orders them.)
+    if bounce_n < T::ZERO {
+        window.of(this_period_n, w.mean_n)
+    } else {
+        window.of(w.mean_n, this_period_n)
+    }
 }
 
 /// The tension loop's state.
@@ -276,6 +279,7 @@ impl<T: Real> TensionStage<T> {
     }
 
     /// The loop's laws at the reduced mass of the length `length_m`.
+    #[inline]
     fn at_mass(&self, length_m: T) -> AtMass<T> {
         match self.fixed_mass {
             Some(m) => m,
@@ -291,6 +295,7 @@ impl<T: Real> TensionStage<T> {
     /// `radial_kg`: the washout of the free tension it measures, and the mode that follows
     /// (§17.6). Returns the band-passed free tension the admittance term acts on, N (0 without
     /// a sample to act on).
+    #[inline]
     fn read_load_cell(&mut self, tension_n: Option<T>, radial_kg: T) -> T {
         // (One comparison: false for NaN and the infinities too.)
         let plausible = T::from_f64(MAX_PLAUSIBLE_TENSION_N);
@@ -349,14 +354,21 @@ impl<T: Real> TensionStage<T> {
         };
         let share = self.share.at(x.delta_rad);
         self.attitude_share = share;
-        let a_env = self.envelope_accel_mps2;
-        let a_hi = a_hi + share * (a_env - a_hi).max(T::ZERO);
-        let a_lo = a_lo - share * (a_env + a_lo).max(T::ZERO);
+        let (a_lo, a_hi) = if share > T::ZERO {
+            let a_env = self.envelope_accel_mps2;
+            (
+                a_lo - share * (a_env + a_lo).max(T::ZERO),
+                a_hi + share * (a_env - a_hi).max(T::ZERO),
+            )
+        } else {
+            (a_lo, a_hi)
+        };
 
         // The shaped law (17.8), from the last command less its admittance part.
         let anchor_mps = x.previous_mps - self.last_admittance_mps;
         let (lo, hi) = (anchor_mps + a_lo * dt, anchor_mps + a_hi * dt);
-        let shaped_mps = x.law_rate_mps.clamp_to(lo, hi);
+        // (The law's rate is finite: `law::solve` faults otherwise.)
+        let shaped_mps = x.law_rate_mps.clamp_finite(lo, hi);
         let shaped = shaped_mps != x.law_rate_mps;
         self.last_shaped_accel_mps2 = (shaped_mps - anchor_mps) / dt;
 
