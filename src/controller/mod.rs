@@ -87,6 +87,7 @@ mod events;
 mod health;
 mod output;
 pub(crate) mod protection;
+mod report;
 mod sequencer;
 mod tension;
 
@@ -110,10 +111,11 @@ pub use output::{Fault, Flags, Health, Output, Phase};
 pub use protection::MARGIN_OF_GRAVITY_GRADIENT;
 
 use clock::{Clock, Elapsed};
-use estimation::{Commanded, Estimated, Estimation};
+use estimation::{Estimated, Estimation};
 use events::EventQueue;
 use health::{DeadReckoning, HealthMachine};
 use protection::{FreeTensionModel, Protection};
+use report::Reported;
 use sequencer::Sequencer;
 use tension::{RestInput, StageInput, TensionStage};
 
@@ -262,19 +264,6 @@ struct LawParts<T> {
     ref_rate_radps: T,
     delta_rad: T,
     delta_rate_radps: T,
-}
-
-/// What a step reported that an event tells when it changes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Reported {
-    health: Health,
-    phase: Phase,
-    fault: Option<Fault>,
-    /// How many times the Eq. 29 blend has (re)started.
-    blend_restarts: u32,
-    /// The phase was found no longer getting closer to its keep length.
-    stalled: bool,
-    tension_limited: bool,
 }
 
 impl<T: Real> Controller<T> {
@@ -881,159 +870,7 @@ impl<T: Real> Controller<T> {
             fault,
         }
     }
-
-    /// Report the step at `tick` ([`Controller::output`]): the command becomes the last command
-    /// (and, flying on the estimator, the drive of its next prediction), its place in the
-    /// existence region (Eq. 13), and the events of what changed since the last report.
-    // Inlined into the step: out of line, the decided command goes through memory and the
-    // step grows by some 4 % (scripts/bench-target).
-    #[inline(always)]
-    fn report(&mut self, tick: u32, d: &Decided<T>) {
-        self.last_command = d.command;
-        let margin = self.equilibrium_margin(d.normalised_rate);
-        let mut flags = d.flags;
-        flags.set_if(margin < T::ZERO, Flags::NO_EQUILIBRIUM);
-        let nis = self.estimation.as_mut().and_then(|est| {
-            est.end_step(Commanded {
-                length_m: d.length_m,
-                rate_mps: d.command.rate_mps,
-                accel_mps2: d.command.accel_mps2,
-                mu3: d.mu3,
-            })
-        });
-        let now = Reported {
-            health: self.health.health(),
-            phase: self.sequencer.phase(),
-            fault: d.fault,
-            blend_restarts: self.sequencer.blend_restarts(),
-            stalled: self.sequencer.stalled(),
-            tension_limited: flags.contains(Flags::TENSION_LIMITED),
-        };
-        flags.set(self.record_changes(tick, now));
-        let law = &d.law;
-        self.out = Output {
-            tick,
-            phase: now.phase,
-            health: now.health,
-            rate_cmd_mps: d.command.rate_mps,
-            accel_cmd_mps2: d.command.accel_mps2,
-            law_rate_mps: law.law_rate_mps,
-            blend_weight: d.blend_weight,
-            alpha_ref_rad: d.alpha_ref_rad,
-            alpha_ref_rate_radps: law.ref_rate_radps,
-            delta_rad: law.delta_rad,
-            delta_rate_radps: law.delta_rate_radps,
-            length_estimate_m: d.length_m,
-            equilibrium_margin: margin,
-            nis,
-            flags,
-            fault: d.fault,
-        };
-    }
-
-    /// The events of what changed from the last report to `now`, in this order: health,
-    /// phase, a new fault, a blend restart, a stall, the tension bound beginning to act. Returns
-    /// the flags that say so in the output ([`Flags::HEALTH_CHANGED`],
-    /// [`Flags::PHASE_CHANGED`], [`Flags::BLEND_RESTART`], [`Flags::NO_PROGRESS`]).
-    fn record_changes(&mut self, tick: u32, now: Reported) -> u32 {
-        let mut flags = Flags::default();
-        if now == self.reported {
-            flags.set_if(now.stalled, Flags::NO_PROGRESS);
-            return flags.0;
-        }
-        let last = core::mem::replace(&mut self.reported, now);
-        let mut record = |kind| self.events.push(Event { tick, kind });
-        if now.health != last.health {
-            flags.set(Flags::HEALTH_CHANGED);
-            record(EventKind::Health {
-                from: last.health,
-                to: now.health,
-            });
-        }
-        if now.phase != last.phase {
-            flags.set(Flags::PHASE_CHANGED);
-            record(EventKind::Phase(now.phase));
-        }
-        if let Some(f) = now.fault.filter(|_| now.fault != last.fault) {
-            record(EventKind::Fault(f));
-        }
-        if now.blend_restarts != last.blend_restarts {
-            flags.set(Flags::BLEND_RESTART);
-            record(EventKind::BlendRestart);
-        }
-        if now.stalled {
-            flags.set(Flags::NO_PROGRESS);
-            if !last.stalled {
-                record(EventKind::NoProgress(now.phase));
-            }
-        }
-        if now.tension_limited && !last.tension_limited {
-            record(EventKind::TensionLimited);
-        }
-        flags.0
-    }
-
-    /// The Eq. 13 whole-orbit margin of a command whose normalised rate (Eq. 7) is `x`:
-    /// min Depl − |x| (> 0 inside the region). Near docking x grows as 1/l, so the margin is
-    /// reported no lower than −[`MAX_REPORTED_MARGIN`] (it is never above min Depl); a zero
-    /// length estimate (a long coast toward docking) makes x infinite or NaN, reported as that
-    /// bound: far outside.
-    fn equilibrium_margin(&self, x: T) -> T {
-        let margin = self.existence.whole_orbit_margin_of(x);
-        let lowest = T::from_f64(-MAX_REPORTED_MARGIN);
-        if margin >= lowest {
-            margin
-        } else {
-            lowest
-        }
-    }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The paper's stage 1 at `tick` with the load cell reading `tension_n`.
-    fn sample(tick: u32, tension_n: Option<f64>) -> Input<f64> {
-        Input {
-            tick,
-            length_m: 1.0 + 0.1 * f64::from(tick),
-            reel_rate_mps: None,
-            tension_n,
-            alpha_rad: Some(-35.0_f64.to_radians()),
-            alpha_rate_radps: Some(0.0),
-            orbit_rate_radps: 1.0602e-3,
-            true_anomaly_rad: 0.0,
-        }
-    }
-
-    #[test]
-    fn the_tension_limit_is_an_event_each_time_it_begins() {
-        // A load cell the protection follows within a period, and a low tension limit.
-        let protection = ProtectionConfig {
-            max_tension_n: 0.5,
-            tension_filter_s: 1.0,
-            ..ProtectionConfig::default_for_period()
-        };
-        let cfg = Config {
-            protection: Some(protection),
-            ..Config::<f64>::paper()
-        };
-        let mut ctl = Controller::new(cfg).unwrap();
-        // Inside the window, above it (limited), no reading (no tension bound), above it again.
-        let (ok, over) = (Some(0.1), Some(5.0));
-        let tensions = [ok, ok, over, over, over, None, None, over, over];
-        let mut limited = [false; 9];
-        let mut began = [false; 9];
-        for (tick, &t) in (0u32..).zip(&tensions) {
-            let out = ctl.step(&sample(tick, t));
-            limited[tick as usize] = out.flags.contains(Flags::TENSION_LIMITED);
-            while let Some(e) = ctl.pop_event() {
-                began[tick as usize] |= e.kind == EventKind::TensionLimited;
-            }
-        }
-        let (f, t) = (false, true);
-        assert_eq!(limited, [f, f, t, t, t, f, f, t, t]);
-        assert_eq!(began, [f, f, t, f, f, f, f, t, f]);
-    }
-}
+mod tests;
