@@ -222,8 +222,8 @@ struct Solved<T> {
     reduced_length_m: T,
     /// The Eq. 29 blend weight E.
     blend_weight: T,
-    /// The state of Eq. 5a's free tension, for the protection.
-    free_tension: FreeTensionModel<T>,
+    /// cos 2α of the solution, for the protection's model of Eq. 5a's free tension.
+    cos_two_alpha: T,
 }
 
 /// The law's demand after the tension loop (docs/equations.md §17): shaped to what the tether
@@ -660,7 +660,7 @@ impl<T: Real> Controller<T> {
             mu3,
             reduced_length_m: solution.reduced_length_m,
             blend_weight: input.blend.weight,
-            free_tension: FreeTensionModel::of(&input, &solution),
+            cos_two_alpha: solution.cos_two_alpha,
         })
     }
 
@@ -717,7 +717,15 @@ impl<T: Real> Controller<T> {
     ) -> Decided<T> {
         let (l, dt) = (s.input.length_m, self.cfg.period_s);
         let previous = self.last_command.rate_mps;
-        let bounds = self.bounds(Some(&solved.free_tension), previous, true);
+        let x = s.input;
+        let model = FreeTensionModel::at(
+            l,
+            x.orbit_rate_radps,
+            reference.orbit.as_ref(),
+            s.alpha_rate_radps,
+            solved.cos_two_alpha,
+        );
+        let bounds = self.bounds(Some(&model), previous, true);
         let demand = shaped.demand;
         let (rate_mps, accel_mps2, sat) =
             self.envelope

@@ -87,20 +87,40 @@ pub(crate) struct FreeTensionModel<T> {
 }
 
 impl<T: Real> FreeTensionModel<T> {
-    /// The state the law solved for. μ/R³ is the law's: n² on a circular orbit (θ̇² would be
-    /// wrong by the factor 1 + e cos θ on an eccentric one, ±30 % at e = 0.3).
+    /// The state the law solved for, from its input and solution ([`FreeTensionModel::at`]).
+    #[cfg(test)]
     pub(crate) fn of(x: &crate::law::LawInput<T>, s: &crate::law::LawOutput<T>) -> Self {
-        let n = x.orbit_rate_radps;
+        Self::at(
+            x.length_m,
+            x.orbit_rate_radps,
+            x.orbit.as_ref(),
+            x.alpha_rate_radps,
+            s.cos_two_alpha,
+        )
+    }
+
+    /// The state the law solved for: length `length_m` (m), orbit rate n = `orbit_rate_radps`,
+    /// the law's orbit forcing `orbit` (`None` on a circular orbit), α̇ = `alpha_rate_radps`
+    /// and the law's `cos_two_alpha`. μ/R³ is the law's: n² on a circular orbit (θ̇² would be
+    /// wrong by the factor 1 + e cos θ on an eccentric one, ±30 % at e = 0.3).
+    pub(crate) fn at(
+        length_m: T,
+        orbit_rate_radps: T,
+        orbit: Option<&crate::law::OrbitForcing<T>>,
+        alpha_rate_radps: T,
+        cos_two_alpha: T,
+    ) -> Self {
+        let n = orbit_rate_radps;
         Self {
-            length_m: x.length_m,
+            length_m,
             orbit_rate_radps: n,
-            gravity_gradient_per_s2: match &x.orbit {
+            gravity_gradient_per_s2: match orbit {
                 // The law's 1.5 μ/R³.
                 Some(o) => o.gradient_per_s2 * T::from_f64(2.0 / 3.0),
                 None => n * n,
             },
-            alpha_rate_radps: x.alpha_rate_radps,
-            cos_two_alpha: s.cos_two_alpha,
+            alpha_rate_radps,
+            cos_two_alpha,
         }
     }
 }
