@@ -718,14 +718,16 @@ impl<T: Real> Controller<T> {
         let (l, dt) = (s.input.length_m, self.cfg.period_s);
         let previous = self.last_command.rate_mps;
         let x = s.input;
-        let model = FreeTensionModel::at(
-            l,
-            x.orbit_rate_radps,
-            reference.orbit.as_ref(),
-            s.alpha_rate_radps,
-            solved.cos_two_alpha,
-        );
-        let bounds = self.bounds(Some(&model), previous, true);
+        let model = self.protection.is_some().then(|| {
+            FreeTensionModel::at(
+                l,
+                x.orbit_rate_radps,
+                reference.orbit.as_ref(),
+                s.alpha_rate_radps,
+                solved.cos_two_alpha,
+            )
+        });
+        let bounds = self.bounds(model.as_ref(), previous, true);
         let demand = shaped.demand;
         let (rate_mps, accel_mps2, sat) =
             self.envelope
@@ -751,8 +753,8 @@ impl<T: Real> Controller<T> {
     }
 
     /// The protection's bounds of this step, from the law's state `model` (`None` when the law
-    /// did not run: the model is stale, the free tension the load cell's own); none without a
-    /// protection. `shared`: the law's command, whose floor gives way to the attitude as the
+    /// did not run: the model is stale, the free tension the load cell's own; the law's step
+    /// builds it only for a protection); none without a protection. `shared`: the law's command, whose floor gives way to the attitude as the
     /// tension loop's window does (docs/equations.md §17.5), when there is a tension loop.
     fn bounds(
         &mut self,
