@@ -495,9 +495,6 @@ impl<T: Real> Controller<T> {
 
     /// The mode command that waits, applied at the boundary `tick` with the reel at `rate_mps`
     /// ([`EventKind::Command`]).
-    // Out of line: a command waits in few periods, and inlined into the step its code made
-    // every step longer (scripts/bench-target).
-    #[inline(never)]
     fn apply_command(&mut self, tick: u32, rate_mps: T) {
         let applied = self.sequencer.apply_pending(tick, rate_mps);
         self.events.record(tick, applied.map(EventKind::Command));

@@ -25,8 +25,8 @@ impl<T: Real> Controller<T> {
     /// Report the step at `tick` ([`Controller::output`]): the command becomes the last command
     /// (and, flying on the estimator, the drive of its next prediction), its place in the
     /// existence region (Eq. 13), and the events of what changed since the last report.
-    // Inlined into the step: out of line, the decided command goes through memory and the
-    // step grows by some 4 % (scripts/bench-target).
+    // Inlined into the step: out of line, the decided command goes through memory once more
+    // and the step grows by some 2 % (scripts/bench-target).
     #[inline(always)]
     pub(super) fn report(&mut self, tick: u32, d: &Decided<T>) {
         self.last_command = d.command;
