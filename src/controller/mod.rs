@@ -495,6 +495,9 @@ impl<T: Real> Controller<T> {
 
     /// The mode command that waits, applied at the boundary `tick` with the reel at `rate_mps`
     /// ([`EventKind::Command`]).
+    // Out of line: inlined into the step, the command's match becomes a computed branch
+    // (`mov pc`) there, which scripts/panic-check cannot follow; a command waits in few periods.
+    #[inline(never)]
     fn apply_command(&mut self, tick: u32, rate_mps: T) {
         let applied = self.sequencer.apply_pending(tick, rate_mps);
         self.events.record(tick, applied.map(EventKind::Command));
