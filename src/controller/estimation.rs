@@ -6,7 +6,7 @@
 //! the drive is the range between the satellites, the reel's length stretched by the load
 //! cell's tension (docs/equations.md §13.2).
 
-use crate::config::{estimator_error, ConfigError, TensionLoopConfig};
+use crate::config::{estimator_error, ConfigError, MonitorConfig, Rule, TensionLoopConfig};
 use crate::estimator::{
     self, Drive, DriveError, Estimate, Estimator, Measurement, OrbitTerms, Prediction,
 };
@@ -72,7 +72,8 @@ impl<T: Real> Stretch<T> {
     /// negative reading is a slack tether (no stretch).
     fn of(&self, x: &Input<T>) -> Option<T> {
         let t = x.tension_n.filter(|t| t.is_finite())?;
-        Some(x.length_m * t.clamp_to(T::ZERO, self.max_tension_n) * self.compliance_per_n)
+        // Finite (filtered above): no NaN for the clamp to handle.
+        Some(x.length_m * t.clamp_finite(T::ZERO, self.max_tension_n) * self.compliance_per_n)
     }
 }
 
@@ -113,13 +114,32 @@ pub(super) struct Estimation<T: Real> {
 
 impl<T: Real> Estimation<T> {
     /// The estimator of `cfg` (validated with the controller's configuration) on `orbit`; with
-    /// the tension loop `tension`, its drive counts the tether's stretch.
+    /// the tension loop `tension`, its drive counts the tether's stretch. The orbit rates
+    /// `monitor` admits must be rates the estimator admits
+    /// ([`estimator::MIN_CIRCULAR_ORBIT_RATE_RADPS`], [`estimator::MAX_ORBIT_RATE_RADPS`]):
+    /// a sample's θ̇ is then checked once, by the monitor.
     pub(super) fn new(
         cfg: &estimator::Config<T>,
         orbit: &Orbit<T>,
         tension: Option<&TensionLoopConfig<T>>,
+        monitor: &MonitorConfig<T>,
     ) -> Result<Self, ConfigError> {
         let filter = Estimator::new(*cfg).map_err(estimator_error)?;
+        let (min, max) = (monitor.min_orbit_rate_radps, monitor.max_orbit_rate_radps);
+        if !(min >= T::from_f64(estimator::MIN_CIRCULAR_ORBIT_RATE_RADPS)) {
+            return Err(ConfigError::new(
+                "monitor.min_orbit_rate_radps",
+                min,
+                Rule::OutOfRange,
+            ));
+        }
+        if !(max <= T::from_f64(estimator::MAX_ORBIT_RATE_RADPS)) {
+            return Err(ConfigError::new(
+                "monitor.max_orbit_rate_radps",
+                max,
+                Rule::OutOfRange,
+            ));
+        }
         let max_alpha_var_rad2 =
             T::from_f64(MAX_ALPHA_VARIANCE_IN_SAMPLES) * filter.measurement_var_rad2();
         let eccentric = (orbit.eccentricity > T::ZERO).then_some(*orbit);
@@ -288,8 +308,9 @@ impl<T: Real> Estimation<T> {
         lost
     }
 
-    /// Keeps the orbit's terms at a sample: θ̈ and μ/R³ from θ on an eccentric orbit, θ̇² and
-    /// no θ̈ on a circular one.
+    /// Keeps the orbit's terms at an accepted sample: θ̈ and μ/R³ from θ on an eccentric orbit,
+    /// θ̇² and no θ̈ on a circular one (θ̇ in range: the monitor checked it against its band,
+    /// inside the estimator's, see [`Estimation::new`]).
     fn sense_orbit(&mut self, rate_radps: T, true_anomaly_rad: T) {
         self.orbit = match &self.eccentric {
             Some(o) => OrbitTerms::new(
@@ -297,7 +318,7 @@ impl<T: Real> Estimation<T> {
                 o.true_anomaly_accel_radps2(true_anomaly_rad),
                 o.gravity_gradient_per_s2(true_anomaly_rad),
             ),
-            None => OrbitTerms::circular(rate_radps),
+            None => Ok(OrbitTerms::circular_in_range(rate_radps)),
         };
     }
 
@@ -333,6 +354,36 @@ impl<T: Real> Estimation<T> {
 mod tests {
     use super::*;
 
+    /// The default monitor's configuration.
+    fn monitor() -> MonitorConfig<f64> {
+        MonitorConfig::default_for_period()
+    }
+
+    /// A monitor that admits orbit rates the estimator does not is refused: the estimator
+    /// builds a circular orbit's terms from the θ̇ the monitor accepted, unchecked.
+    #[test]
+    fn the_monitor_admits_only_orbit_rates_the_estimator_admits() {
+        let cfg = estimator::Config::<f64>::paper();
+        let orbit = Orbit::circular(7_078_000.0);
+        let wide = |min: f64, max: f64| MonitorConfig {
+            min_orbit_rate_radps: min,
+            max_orbit_rate_radps: max,
+            ..monitor()
+        };
+        let refused = |m: MonitorConfig<f64>| Estimation::new(&cfg, &orbit, None, &m).err();
+        assert_eq!(refused(monitor()), None);
+        let low = refused(wide(1e-11, 1e-2)).unwrap();
+        assert_eq!(
+            (low.param, low.rule),
+            ("monitor.min_orbit_rate_radps", Rule::OutOfRange)
+        );
+        let high = refused(wide(1e-5, 2e-2)).unwrap();
+        assert_eq!(
+            (high.param, high.rule),
+            ("monitor.max_orbit_rate_radps", Rule::OutOfRange)
+        );
+    }
+
     /// An accepted sample at the orbit rate `n`, the length `length_m` and the load cell's
     /// `tension_n`.
     fn sample(n: f64, length_m: f64, tension_n: Option<f64>) -> Input<f64> {
@@ -356,7 +407,7 @@ mod tests {
         let cfg = estimator::Config::<f64>::paper();
         let loop_cfg = TensionLoopConfig::<f64>::dyneema_half_mm();
         let orbit = Orbit::circular(7_078_000.0);
-        let mut e = Estimation::new(&cfg, &orbit, Some(&loop_cfg)).unwrap();
+        let mut e = Estimation::new(&cfg, &orbit, Some(&loop_cfg), &monitor()).unwrap();
         let n = 1.06e-3;
         let ea = loop_cfg.axial_stiffness_n;
         assert_eq!(
@@ -388,7 +439,7 @@ mod tests {
             e.sense_stretch(2, Some(&sample(n, 20_000.0, Some(6.0)))),
             0.0
         );
-        let mut rigid = Estimation::new(&cfg, &orbit, None).unwrap();
+        let mut rigid = Estimation::new(&cfg, &orbit, None, &monitor()).unwrap();
         let _ = rigid.sense_stretch(0, Some(&sample(n, 20_000.0, Some(5.0))));
         assert_eq!(
             rigid.sense_stretch(1, Some(&sample(n, 20_000.0, Some(6.0)))),
@@ -399,7 +450,8 @@ mod tests {
     #[test]
     fn the_drive_takes_the_orbit_terms_from_theta_on_an_eccentric_orbit_only() {
         let cfg = estimator::Config::<f64>::paper();
-        let mut circular = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), None).unwrap();
+        let mut circular =
+            Estimation::new(&cfg, &Orbit::circular(7_078_000.0), None, &monitor()).unwrap();
         let n = 1.06e-3;
         circular.sense_orbit(n, 2.0);
         let t = circular.orbit.unwrap();
@@ -407,7 +459,7 @@ mod tests {
         assert_eq!(t.accel_radps2().to_bits(), 0.0_f64.to_bits());
         assert_eq!(t.gravity_gradient_per_s2(), n * n);
         let orbit = Orbit::elliptic(7_078_000.0, 0.1);
-        let mut eccentric = Estimation::new(&cfg, &orbit, None).unwrap();
+        let mut eccentric = Estimation::new(&cfg, &orbit, None, &monitor()).unwrap();
         let theta = 2.0;
         eccentric.sense_orbit(n, theta);
         let t = eccentric.orbit.unwrap();
@@ -423,7 +475,9 @@ mod tests {
     #[test]
     fn refused_orbit_terms_drop_the_estimate_as_a_refused_drive() {
         let cfg = estimator::Config::<f64>::paper();
-        let mut e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), None).unwrap();
+        // On an eccentric orbit (a circular one's θ̇ is the monitor's to refuse).
+        let orbit = Orbit::elliptic(7_078_000.0, 0.1);
+        let mut e = Estimation::new(&cfg, &orbit, None, &monitor()).unwrap();
         let c = Commanded {
             length_m: 100.0,
             rate_mps: 2.0,
@@ -444,7 +498,7 @@ mod tests {
     #[test]
     fn the_drive_is_the_last_command_or_the_measured_mean_rate() {
         let cfg = estimator::Config::<f64>::paper();
-        let e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), None).unwrap();
+        let e = Estimation::new(&cfg, &Orbit::circular(7_078_000.0), None, &monitor()).unwrap();
         let orbit = OrbitTerms::circular(1.06e-3).unwrap();
         let c = Commanded {
             length_m: 100.0,

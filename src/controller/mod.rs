@@ -282,9 +282,12 @@ impl<T: Real> Controller<T> {
         let spool_m = T::from_f64(cfg.envelope.max_length_m.to_f64() * (1.0 + SPOOL_MARGIN));
         let estimation = match &cfg.rate_source {
             RateSource::Sensor => None,
-            RateSource::Estimator(est) => {
-                Some(Estimation::new(est, &cfg.orbit, cfg.tension_loop.as_ref())?)
-            }
+            RateSource::Estimator(est) => Some(Estimation::new(
+                est,
+                &cfg.orbit,
+                cfg.tension_loop.as_ref(),
+                &cfg.monitor,
+            )?),
         };
         let sequencer = Sequencer::new(&cfg);
         Ok(Self {

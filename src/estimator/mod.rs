@@ -225,16 +225,23 @@ impl<T: Real> OrbitTerms<T> {
             T::from_f64(MAX_ORBIT_RATE_RADPS),
         );
         if rate_radps >= min && rate_radps <= max {
-            Ok(Self {
-                rate_radps,
-                accel_radps2: T::ZERO,
-                gravity_gradient_per_s2: rate_radps * rate_radps,
-            })
+            Ok(Self::circular_in_range(rate_radps))
         } else {
             Err(DriveError {
                 input: DriveInput::OrbitRate,
                 value: rate_radps.to_f64(),
             })
+        }
+    }
+
+    /// The terms of a circular orbit of rate n (rad/s), for an n its caller has checked
+    /// against a band inside [[`MIN_CIRCULAR_ORBIT_RATE_RADPS`], [`MAX_ORBIT_RATE_RADPS`]]
+    /// (the controller's monitor, whose band the controller checks once, at construction).
+    pub(crate) fn circular_in_range(rate_radps: T) -> Self {
+        Self {
+            rate_radps,
+            accel_radps2: T::ZERO,
+            gravity_gradient_per_s2: rate_radps * rate_radps,
         }
     }
 
