@@ -217,6 +217,17 @@ fn message(sc: &Scenario, e: &ConfigError, key: &str, x: f64) -> String {
              (sensors.alpha_rate.enabled = true) to fly without the estimator"
                 .to_string()
         }
+        Rule::OutOfRange
+            if key == "monitor.min_orbit_rate_radps" || key == "monitor.max_orbit_rate_radps" =>
+        {
+            format!(
+                "must be within the orbit rates the controller's estimator admits, {} to {} \
+                 rad/s (tss_reel::estimator::MIN_CIRCULAR_ORBIT_RATE_RADPS, \
+                 MAX_ORBIT_RATE_RADPS)",
+                num(tss_reel::estimator::MIN_CIRCULAR_ORBIT_RATE_RADPS),
+                num(tss_reel::estimator::MAX_ORBIT_RATE_RADPS)
+            )
+        }
         Rule::TooLarge => "is so large that monitor.coast_ticks × monitor.good_samples_per_bad \
                            overflows a 32-bit count"
             .to_string(),

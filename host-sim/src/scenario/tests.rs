@@ -482,6 +482,7 @@ fn every_rule_names_file_field_and_value() {
         (&["monitor.length_jump_m=0"], "monitor.length_jump_m", "0", "must be above 0"),
         (&["monitor.max_orbit_rate_radps=-1"], "monitor.max_orbit_rate_radps", "-1", "must be above monitor.min_orbit_rate_radps"),
         (&["monitor.max_orbit_rate_radps=1e-6"], "monitor.max_orbit_rate_radps", "0.000001", "must be above monitor.min_orbit_rate_radps = 0.00001"),
+        (&["sensors.alpha_rate.enabled=false", "monitor.max_orbit_rate_radps=0.02"], "monitor.max_orbit_rate_radps", "0.02", "must be within the orbit rates the controller's estimator admits"),
         (&["protection.enabled=true", "protection.min_tension_n=-1"], "protection.min_tension_n", "-1", "must not be negative"),
         (&["protection.enabled=true", "protection.max_tension_n=0.001"], "protection.max_tension_n", "0.001", "must be above protection.min_tension_n = 0.002"),
         (&["protection.enabled=true", "protection.max_tension_n=1e6"], "protection.max_tension_n", "1000000", "must be at most 100000 N"),
