@@ -117,7 +117,8 @@ impl<T: Real> Estimation<T> {
     /// the tension loop `tension`, its drive counts the tether's stretch. The orbit rates
     /// `monitor` admits must be rates the estimator admits
     /// ([`estimator::MIN_CIRCULAR_ORBIT_RATE_RADPS`], [`estimator::MAX_ORBIT_RATE_RADPS`]):
-    /// a sample's θ̇ is then checked once, by the monitor.
+    /// a sample's θ̇ is then checked once, by the monitor. (`monitor` is validated: its band is
+    /// finite.)
     pub(super) fn new(
         cfg: &estimator::Config<T>,
         orbit: &Orbit<T>,
@@ -126,14 +127,14 @@ impl<T: Real> Estimation<T> {
     ) -> Result<Self, ConfigError> {
         let filter = Estimator::new(*cfg).map_err(estimator_error)?;
         let (min, max) = (monitor.min_orbit_rate_radps, monitor.max_orbit_rate_radps);
-        if !(min >= T::from_f64(estimator::MIN_CIRCULAR_ORBIT_RATE_RADPS)) {
+        if min < T::from_f64(estimator::MIN_CIRCULAR_ORBIT_RATE_RADPS) {
             return Err(ConfigError::new(
                 "monitor.min_orbit_rate_radps",
                 min,
                 Rule::OutOfRange,
             ));
         }
-        if !(max <= T::from_f64(estimator::MAX_ORBIT_RATE_RADPS)) {
+        if max > T::from_f64(estimator::MAX_ORBIT_RATE_RADPS) {
             return Err(ConfigError::new(
                 "monitor.max_orbit_rate_radps",
                 max,
