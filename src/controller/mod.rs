@@ -72,7 +72,11 @@
 //!   docs/equations.md §13);
 //! - the encoder's reel rate, the drive of the prediction, is checked by the monitor
 //!   ([`Sensor::ReelRate`]): a sample with a reel rate it rejects is a bad sample, and the
-//!   estimate is carried over the period at the command.
+//!   estimate is carried over the period at the command;
+//! - so is the orbit rate θ̇, which on a circular orbit gives the prediction's θ̇ and μ/R³ = θ̇²
+//!   ([`Sensor::OrbitRate`]): the configuration is refused unless the monitor's band
+//!   (`monitor.min_orbit_rate_radps` to `monitor.max_orbit_rate_radps`) lies within the rates
+//!   the estimator admits, so a θ̇ the monitor accepts is one the prediction may use.
 //!
 //! On either rate source, an α (sensed, or α̂) beyond [`MAX_LIBRATION_RAD`] is a libration
 //! beyond the law's domain ([`Fault::Libration`]): safe hold at once, the reel brought to rest
