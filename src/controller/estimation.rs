@@ -188,7 +188,8 @@ impl<T: Real> Estimation<T> {
     /// (0 at the first), the reel having run at the accepted `sample`'s measured rate (if the
     /// encoder gave one) or at the last command, the tether stretched as its load cell says
     /// (with a tension loop), then updates it with this period's α (`None`: the swing sensor
-    /// gave nothing, or the sample was rejected). The orbit's terms are those of the accepted
+    /// gave nothing, or the sample was rejected; an accepted one is an angle, the monitor
+    /// checked it). The orbit's terms are those of the accepted
     /// sample (`None`: the last ones hold). Returns the verdict and the event it makes, if any.
     pub(super) fn step(
         &mut self,
@@ -218,7 +219,11 @@ impl<T: Real> Estimation<T> {
                 had
             }
         };
-        let m = self.filter.update_with(alpha_rad);
+        // An accepted α is an angle: the monitor checked it (finite, |α| ≤ π).
+        let m = match alpha_rad {
+            Some(z) => self.filter.update(z),
+            None => Measurement::Missing,
+        };
         let estimate = self.filter.alpha_rate_and_variance();
         let (nis, event) = match m {
             Measurement::Accepted(i) | Measurement::Gated(i) => (Some(i.nis), None),

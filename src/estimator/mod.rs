@@ -648,8 +648,9 @@ impl<T: Real> Estimator<T> {
     }
 
     /// The update with this period's sample (module docs, *Gating*, *Covariance*), in place.
-    /// `z`: an angle, |z| ≤ π.
-    fn update(&mut self, z: T) -> Measurement<T> {
+    /// `z`: an angle, |z| ≤ π (as [`Estimator::update_with`] checks, and the controller's
+    /// monitor before it).
+    pub(crate) fn update(&mut self, z: T) -> Measurement<T> {
         let r = self.measurement_var;
         let (gate_nis, max_rejections) = (self.config.gate_nis, self.config.max_rejections);
         let Some(t) = &mut self.track else {
