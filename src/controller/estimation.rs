@@ -87,6 +87,26 @@ pub(super) enum Estimated<T> {
     Unusable(Sensor),
 }
 
+/// The orbit of an accepted sample, as the prediction's drive reads it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum SensedOrbit<T> {
+    /// A circular orbit's θ̇, rad/s (θ̈ = 0, μ/R³ = θ̇²), in the estimator's range: the monitor
+    /// checked it against its band, which [`Estimation::new`] checked against the estimator's.
+    Circular(T),
+    /// An eccentric orbit's θ̇, θ̈ and μ/R³ at the sample's θ, or why they were refused.
+    Eccentric(Result<OrbitTerms<T>, DriveError>),
+}
+
+impl<T: Real> SensedOrbit<T> {
+    /// The orbit's terms, or why they were refused.
+    fn terms(&self) -> Result<OrbitTerms<T>, DriveError> {
+        match *self {
+            Self::Circular(rate_radps) => Ok(OrbitTerms::circular_in_range(rate_radps)),
+            Self::Eccentric(terms) => terms,
+        }
+    }
+}
+
 /// The estimator in the loop.
 #[derive(Clone, Debug)]
 pub(super) struct Estimation<T: Real> {
@@ -96,10 +116,10 @@ pub(super) struct Estimation<T: Real> {
     eccentric: Option<Orbit<T>>,
     /// Var(α̂) beyond which the law may not use the estimate, rad².
     max_alpha_var_rad2: T,
-    /// The orbit's terms at the last accepted sample (a period without one is carried with
-    /// them), or why they were refused; before the first, the configured orbit's at periapsis
-    /// (no estimate to carry then: the estimate starts from an accepted sample's α).
-    orbit: Result<OrbitTerms<T>, DriveError>,
+    /// The orbit at the last accepted sample (a period without one is carried with it); before
+    /// the first, the configured orbit at periapsis (no estimate to carry then: the estimate
+    /// starts from an accepted sample's α).
+    orbit: SensedOrbit<T>,
     /// What the last step commanded (`None` before the first step).
     commanded: Option<Commanded<T>>,
     /// The tether's stretch (`None`: no tension loop, a rigid tether's drive).
@@ -148,12 +168,15 @@ impl<T: Real> Estimation<T> {
             filter,
             eccentric,
             max_alpha_var_rad2,
-            // sin θ = 0 at periapsis: θ̈ = 0.
-            orbit: OrbitTerms::new(
-                orbit.true_anomaly_rate_radps(T::ZERO),
-                T::ZERO,
-                orbit.gravity_gradient_per_s2(T::ZERO),
-            ),
+            orbit: match eccentric {
+                None => SensedOrbit::Circular(orbit.true_anomaly_rate_radps(T::ZERO)),
+                // sin θ = 0 at periapsis: θ̈ = 0.
+                Some(o) => SensedOrbit::Eccentric(OrbitTerms::new(
+                    o.true_anomaly_rate_radps(T::ZERO),
+                    T::ZERO,
+                    o.gravity_gradient_per_s2(T::ZERO),
+                )),
+            },
             commanded: None,
             stretch: tension.map(|t| Stretch {
                 compliance_per_n: T::ONE / t.axial_stiffness_n,
@@ -281,7 +304,7 @@ impl<T: Real> Estimation<T> {
             self.filter.reset();
             return false;
         };
-        match self.orbit {
+        match self.orbit.terms() {
             Ok(orbit) => matches!(
                 self.filter.predict_period(&self.drive(
                     &c,
@@ -319,12 +342,12 @@ impl<T: Real> Estimation<T> {
     /// inside the estimator's, see [`Estimation::new`]).
     fn sense_orbit(&mut self, rate_radps: T, true_anomaly_rad: T) {
         self.orbit = match &self.eccentric {
-            Some(o) => OrbitTerms::new(
+            Some(o) => SensedOrbit::Eccentric(OrbitTerms::new(
                 rate_radps,
                 o.true_anomaly_accel_radps2(true_anomaly_rad),
                 o.gravity_gradient_per_s2(true_anomaly_rad),
-            ),
-            None => Ok(OrbitTerms::circular_in_range(rate_radps)),
+            )),
+            None => SensedOrbit::Circular(rate_radps),
         };
     }
 
@@ -460,7 +483,7 @@ mod tests {
             Estimation::new(&cfg, &Orbit::circular(7_078_000.0), None, &monitor()).unwrap();
         let n = 1.06e-3;
         circular.sense_orbit(n, 2.0);
-        let t = circular.orbit.unwrap();
+        let t = circular.orbit.terms().unwrap();
         assert_eq!(t.rate_radps(), n);
         assert_eq!(t.accel_radps2().to_bits(), 0.0_f64.to_bits());
         assert_eq!(t.gravity_gradient_per_s2(), n * n);
@@ -468,7 +491,7 @@ mod tests {
         let mut eccentric = Estimation::new(&cfg, &orbit, None, &monitor()).unwrap();
         let theta = 2.0;
         eccentric.sense_orbit(n, theta);
-        let t = eccentric.orbit.unwrap();
+        let t = eccentric.orbit.terms().unwrap();
         assert_eq!(t.rate_radps(), n);
         assert_eq!(t.accel_radps2(), orbit.true_anomaly_accel_radps2(theta));
         assert_eq!(
