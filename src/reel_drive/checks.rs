@@ -133,7 +133,9 @@ impl CrossChecks {
         let unanswered =
             implied_nm < j.lowest_nm || implied_nm > j.highest_nm || (!trusted && pinned);
         if unanswered {
-            self.unanswered_ticks = self.unanswered_ticks.saturating_add(gap_ticks);
+            // (Cannot wrap: below `ticks` ≤ 2³¹ − 1, for the drive trips at it, plus a gap
+            // below 2³¹.)
+            self.unanswered_ticks = self.unanswered_ticks.wrapping_add(gap_ticks);
             if self.unanswered_ticks >= j.ticks {
                 return Some(DriveFault::NoResponse);
             }

@@ -515,16 +515,15 @@ impl SpeedLoop {
         }
         self.last_tick = Some(tick);
         let mut faults = self.command_faults;
-        if !self.checks.load_cell_trusted {
-            faults.insert(DriveFault::TensionMismatch);
-        }
 
+        let load_cell_n = self.take_tension(input.tension_n, &mut faults);
         let (counted, speed_mps) = self.odometry(tick, gap_ticks, input.encoder_count, &mut faults);
         let counted = counted.is_ok();
-        self.take_tension(input.tension_n, &mut faults);
+        // A dropped load cell is reported by every step, and the feed-forward takes no tension.
         let tension_n = if self.checks.load_cell_trusted {
-            self.load_cell_n
+            load_cell_n
         } else {
+            faults.insert(DriveFault::TensionMismatch);
             0.0
         };
         self.tension_n = tension_n;
@@ -656,13 +655,12 @@ impl SpeedLoop {
         count: Option<u32>,
         faults: &mut DriveFaults,
     ) -> (Result<(), CountFault>, f32) {
-        let trip_ticks = self.cfg.faults.encoder_trip_ticks;
         let reading = if gap_ticks == 1 {
             count
         } else {
             // The ticks the overrun skipped get their predicted totals.
             self.odometer.skip(gap_ticks - 1);
-            if gap_ticks <= trip_ticks {
+            if gap_ticks <= self.cfg.faults.encoder_trip_ticks {
                 count
             } else {
                 None
@@ -670,6 +668,7 @@ impl SpeedLoop {
         };
         let (counted, speed_mps) = self.odometer.update_next(tick, reading);
         if let Err(f) = counted {
+            let trip_ticks = self.cfg.faults.encoder_trip_ticks;
             let since_accepted = self.odometer.ticks_since_accepted(tick);
             let (fault, lost) = match f {
                 // A jump is a reading within the gap the check bridges, against an accepted
@@ -812,46 +811,44 @@ impl SpeedLoop {
 
     /// Takes the load cell's `reading`: one inside [min, max] as is, a finite one outside
     /// clamped into it, a missing or non-finite one not at all (the last usable value stays);
-    /// anything but the first is [`DriveFault::TensionOutOfRange`].
-    fn take_tension(&mut self, reading: Option<f32>, faults: &mut DriveFaults) {
+    /// anything but the first is [`DriveFault::TensionOutOfRange`]. Returns the last usable
+    /// value, N.
+    fn take_tension(&mut self, reading: Option<f32>, faults: &mut DriveFaults) -> f32 {
         let (lo, hi) = (self.cfg.faults.min_tension_n, self.cfg.faults.max_tension_n);
         match reading {
-            Some(t) if (lo..=hi).contains(&t) => {
-                self.load_cell_n = t;
-                return;
+            Some(t) if t >= lo => {
+                if t <= hi {
+                    self.load_cell_n = t;
+                    return t;
+                }
+                if t.is_finite() {
+                    self.load_cell_n = hi;
+                }
             }
-            Some(t) if t.is_finite() => self.load_cell_n = if t > hi { hi } else { lo },
+            // (Below the range, or NaN: the finite ones are below.)
+            Some(t) if t.is_finite() => self.load_cell_n = lo,
             Some(_) | None => {}
         }
         faults.insert(DriveFault::TensionOutOfRange);
+        self.load_cell_n
     }
 }
 
 /// `x` limited to [−limit, limit] (limit ≥ 0), and whether it was beyond, by comparisons
 /// (`f32::clamp` panics on bad bounds; `f32::min`/`max` are library calls on the
-/// Cortex-M4F). A NaN `x` fails both comparisons of the first test and gives 0 (no torque),
-/// not saturated.
+/// Cortex-M4F). Inside the limit is the common case and costs one comparison; beyond it, the
+/// sign says which side. A NaN `x` fails every comparison and gives 0 (no torque), not
+/// saturated.
 fn saturate(x: f32, limit: f32) -> (f32, bool) {
-    if x >= -limit {
-        if x > limit {
-            (limit, true)
-        } else {
-            (x, false)
-        }
-    } else if x < -limit {
+    if x.abs() <= limit {
+        (x, false)
+    } else if x > 0.0 {
+        (limit, true)
+    } else if x < 0.0 {
         (-limit, true)
     } else {
-        not_a_number()
+        (0.0, false)
     }
-}
-
-/// [`saturate`]'s NaN: no torque, not saturated. Cold and out of line, so that LLVM keeps the
-/// saturation's comparisons as branches: if-converted, they cost the step's every saturation
-/// about 10 instructions more (`scripts/bench-target`).
-#[cold]
-#[inline(never)]
-fn not_a_number() -> (f32, bool) {
-    (0.0, false)
 }
 
 #[cfg(test)]
@@ -863,6 +860,7 @@ mod tests {
         assert_eq!(saturate(2.0, 1.0), (1.0, true));
         assert_eq!(saturate(-2.0, 1.0), (-1.0, true));
         assert_eq!(saturate(0.5, 1.0), (0.5, false));
+        assert_eq!(saturate(-1.0, 1.0), (-1.0, false));
         assert_eq!(saturate(f32::NAN, 1.0), (0.0, false));
         assert_eq!(saturate(f32::NEG_INFINITY, 1.0), (-1.0, true));
     }
