@@ -668,26 +668,35 @@ impl SpeedLoop {
         };
         let (counted, speed_mps) = self.odometer.update_next(tick, reading);
         if let Err(f) = counted {
-            let trip_ticks = self.cfg.faults.encoder_trip_ticks;
-            let since_accepted = self.odometer.ticks_since_accepted(tick);
-            let (fault, lost) = match f {
-                // A jump is a reading within the gap the check bridges, against an accepted
-                // one: only the ticks since that one can have run out.
-                CountFault::Jump => (
-                    DriveFault::EncoderJump,
-                    since_accepted.is_some_and(|t| t > trip_ticks),
-                ),
-                CountFault::Missing => (
-                    DriveFault::EncoderMissing,
-                    gap_ticks > trip_ticks || since_accepted.is_some_and(|t| t > trip_ticks),
-                ),
-            };
-            faults.insert(fault);
-            if lost {
-                self.trip(fault);
-            }
+            self.count_fault(f, tick, gap_ticks, faults);
         }
         (counted, speed_mps)
+    }
+
+    /// A reading the odometer did not take at `tick`, `gap_ticks` after the last step: its
+    /// fault, and the trip if the encoder has been without one for too long. Out of line:
+    /// inlined, this rare branch costs the step's every path a register (`scripts/bench-target`).
+    #[cold]
+    #[inline(never)]
+    fn count_fault(&mut self, f: CountFault, tick: u32, gap_ticks: u32, faults: &mut DriveFaults) {
+        let trip_ticks = self.cfg.faults.encoder_trip_ticks;
+        let since_accepted = self.odometer.ticks_since_accepted(tick);
+        let (fault, lost) = match f {
+            // A jump is a reading within the gap the check bridges, against an accepted one:
+            // only the ticks since that one can have run out.
+            CountFault::Jump => (
+                DriveFault::EncoderJump,
+                since_accepted.is_some_and(|t| t > trip_ticks),
+            ),
+            CountFault::Missing => (
+                DriveFault::EncoderMissing,
+                gap_ticks > trip_ticks || since_accepted.is_some_and(|t| t > trip_ticks),
+            ),
+        };
+        faults.insert(fault);
+        if lost {
+            self.trip(fault);
+        }
     }
 
     /// The brake engaged: whether the drum has slipped beyond `brake_slip_m` from where it was
