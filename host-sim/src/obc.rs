@@ -72,7 +72,7 @@ impl Stepper<f32> for Unit {
         Ok(())
     }
 
-    fn take_telemetry(&mut self, housekeeping: bool) -> Vec<Vec<u8>> {
+    fn take_telemetry(&mut self, housekeeping: bool) -> Result<Vec<Vec<u8>>, SimError> {
         if housekeeping {
             let sent = &mut self.sent;
             self.services.report_housekeeping(
@@ -81,7 +81,7 @@ impl Stepper<f32> for Unit {
                 &mut |p| sent.push(p.to_vec()),
             );
         }
-        std::mem::take(&mut self.sent)
+        Ok(std::mem::take(&mut self.sent))
     }
 }
 

@@ -14,6 +14,14 @@
 //! [`crate::sim::run_stepper`] writes the same history, figures and summaries as a host-linked
 //! run. Frames are those of [`tss_reel::link`].
 //!
+//! **Telecommands and telemetry.** The on-board computer's telecommands (`crate::obc`, the
+//! scenario's `[[telecommand]]`) go to the firmware as `Packet` frames before the period's
+//! sample; the firmware's PUS services (the unit's code, on the MCU) answer with telemetry
+//! packets in `Packet` frames: verification reports, events, and the housekeeping of each
+//! period the plant records (asked for with a `Collect` frame). They are kept in the order
+//! they arrive, as a host-linked unit's ([`Stepper::take_telemetry`]), so `telemetry.csv` of a
+//! PIL run is that of a host-linked one.
+//!
 //! **Link faults.** The scenario's `[link]` section injects faults into the sample frames, each
 //! frame meeting at most one: dropped (not sent; the firmware times out), corrupted (one byte
 //! changed, never to the delimiter; the firmware rejects it), duplicated (sent twice; the
@@ -43,9 +51,9 @@ use std::time::{Duration, Instant};
 
 use tss_reel::controller::{Config, Controller, Input, Output};
 use tss_reel::link::{
-    self, Command, End, Frame, FrameReader, LinkCounters, LinkError, LoadVerdict, Loaded, Message,
-    ParamTable, Report, Sample, SampleStatus, MAX_WIRE_LEN, NO_PARAM, PARAMS, SAMPLE_MISSING,
-    SAMPLE_VALID,
+    self, Collect, Command, End, Frame, FrameReader, LinkCounters, LinkError, LoadVerdict, Loaded,
+    Message, Packet, ParamTable, Report, Sample, SampleStatus, MAX_WIRE_LEN, NO_PARAM, PARAMS,
+    SAMPLE_MISSING, SAMPLE_VALID,
 };
 
 use crate::faults::Pcg32;
@@ -181,6 +189,10 @@ pub struct PilReport {
     pub spurious_timeouts: u32,
     /// The firmware's `Report` (its receive counters, commands sent and their digest).
     pub firmware_report: Report,
+    /// Telecommands sent to the firmware (`Packet` frames).
+    pub telecommands: u32,
+    /// Telemetry packets the firmware sent (`Packet` frames).
+    pub telemetry_packets: u32,
     /// Digest of the firmware's built-in configuration (its hello).
     pub builtin_digest: u32,
     /// Digest of the configuration loaded into it and flown.
@@ -249,6 +261,11 @@ impl PilReport {
             f64::from(self.ticks) / secs.max(1e-9),
             self.frames_sent,
             self.plant_rx.frames_ok
+        );
+        let _ = writeln!(
+            o,
+            "  PUS: {} telecommands sent, {} telemetry packets received",
+            self.telecommands, self.telemetry_packets
         );
         let i = &self.injected;
         let _ = writeln!(
@@ -320,6 +337,10 @@ pub struct PilLink {
     rng: Pcg32,
     /// A reordered frame, sent after the next one.
     held: Option<Vec<u8>>,
+    /// Telemetry packets received and not yet taken ([`Stepper::take_telemetry`]).
+    telemetry: Vec<Vec<u8>>,
+    /// The last period the firmware answered.
+    last_tick: u32,
     /// The tick whose frame went out intact and on time (for spurious-timeout detection).
     on_time: bool,
     started: Instant,
@@ -464,6 +485,8 @@ impl PilLink {
             faults: sc.link.clone(),
             rng: Pcg32::new(sc.link.seed, 0x6c69_6e6b), // stream "link"
             held: None,
+            telemetry: Vec::new(),
+            last_tick: 0,
             on_time: false,
             started,
             report: PilReport {
@@ -544,7 +567,24 @@ impl PilLink {
             .map_err(io("writing to the firmware's UART"))
     }
 
-    /// Reads frames until `pick` accepts one, counting the others, for at most `timeout`.
+    /// Sends `message`, a frame of another kind than a sample (a telecommand, a housekeeping
+    /// request, the end), in the one sequence of the plant's frames. A reordered sample
+    /// frame held back goes first, so the frames stay in sequence on the wire.
+    fn send(&mut self, message: &Message, what: &str) -> Result<(), PilError> {
+        if let Some(late) = self.held.take() {
+            self.write(&late)?;
+        }
+        let mut wire = [0u8; MAX_WIRE_LEN];
+        let n = link::encode(self.seq, message, &mut wire)
+            .map_err(|e| self.fail(format!("encoding the {what}: {e:?}")))?;
+        self.seq = self.seq.wrapping_add(1);
+        self.stream
+            .write_all(&wire[..n])
+            .map_err(io("writing to the firmware's UART"))
+    }
+
+    /// Reads frames until `pick` accepts one, keeping the telemetry packets and counting the
+    /// other frames, for at most `timeout`.
     fn receive<T>(
         &mut self,
         timeout: Duration,
@@ -561,7 +601,12 @@ impl PilLink {
                             self.report.plant_rx.frames_ok += 1;
                             return Ok(x);
                         }
-                        self.report.plant_rx.count_error(LinkError::WrongKind);
+                        if let Message::Packet(p) = &frame.message {
+                            self.report.plant_rx.frames_ok += 1;
+                            self.keep(p);
+                        } else {
+                            self.report.plant_rx.count_error(LinkError::WrongKind);
+                        }
                     }
                     Err(LinkError::Version(v)) => {
                         return Err(self.fail(format!(
@@ -675,6 +720,12 @@ impl PilLink {
         self.accept_command(tick, &command)
     }
 
+    /// Keeps the telemetry packet `p`.
+    fn keep(&mut self, p: &Packet) {
+        self.report.telemetry_packets += 1;
+        self.telemetry.push(p.bytes().to_vec());
+    }
+
     fn accept_command(&mut self, tick: u32, c: &Command) -> Result<Output<f32>, PilError> {
         if c.tick != tick {
             return Err(self.fail(format!(
@@ -701,6 +752,7 @@ impl PilLink {
             Some(SampleStatus::NoSample) | None => s.no_sample += 1,
         }
         self.report.ticks += 1;
+        self.last_tick = tick;
         self.report.digest = link::fnv1a_f32(self.report.digest, out.rate_cmd_mps);
         Ok(out)
     }
@@ -744,16 +796,7 @@ impl PilLink {
     /// Ends the run after `ticks` periods: sends a held frame and `End`, reads the firmware's
     /// `Report`, and waits for QEMU and the log decoder to exit.
     pub fn finish(mut self, ticks: u32) -> Result<PilReport, PilError> {
-        if let Some(late) = self.held.take() {
-            self.write(&late)?;
-        }
-        let mut wire = [0u8; MAX_WIRE_LEN];
-        let n = link::encode(self.seq, &Message::End(End { ticks }), &mut wire)
-            .map_err(|e| self.fail(format!("encoding the end frame: {e:?}")))?;
-        self.seq = self.seq.wrapping_add(1);
-        self.stream
-            .write_all(&wire[..n])
-            .map_err(io("writing to the firmware's UART"))?;
+        self.send(&Message::End(End { ticks }), "end frame")?;
         let report = self.receive(REPLY_TIMEOUT, "report frame", |m| match m {
             Message::Report(r) => Some(*r),
             _ => None,
@@ -784,6 +827,45 @@ impl Stepper<f32> for PilLink {
     fn step(&mut self, tick: u32, input: Option<&Input<f32>>) -> Result<Output<f32>, SimError> {
         self.exchange(tick, input)
             .map_err(|e| SimError::Link(Box::new(e)))
+    }
+
+    /// Sends the telecommand `raw` in a `Packet` frame; its verification reports come back
+    /// with the period's command.
+    fn telecommand(&mut self, raw: &[u8]) -> Result<(), SimError> {
+        let packet = Packet::new(raw).ok_or_else(|| {
+            SimError::Link(
+                format!(
+                    "a telecommand of {} bytes does not fit a link packet (1 to {})",
+                    raw.len(),
+                    link::MAX_PACKET_LEN
+                )
+                .into(),
+            )
+        })?;
+        self.send(&Message::Packet(packet), "telecommand")
+            .map_err(|e| SimError::Link(Box::new(e)))?;
+        self.report.telecommands += 1;
+        Ok(())
+    }
+
+    /// The telemetry received since the last call; with `housekeeping`, the firmware is asked
+    /// for the housekeeping of the period it last answered (a `Collect` frame), and its
+    /// packet awaited.
+    fn take_telemetry(&mut self, housekeeping: bool) -> Result<Vec<Vec<u8>>, SimError> {
+        if housekeeping {
+            let tick = self.last_tick;
+            let link = |e: PilError| SimError::Link(Box::new(e));
+            self.send(&Message::Collect(Collect { tick }), "housekeeping request")
+                .map_err(link)?;
+            let hk = self
+                .receive(REPLY_TIMEOUT, "housekeeping packet", |m| match m {
+                    Message::Packet(p) => Some(*p),
+                    _ => None,
+                })
+                .map_err(link)?;
+            self.keep(&hk);
+        }
+        Ok(std::mem::take(&mut self.telemetry))
     }
 }
 

@@ -142,13 +142,6 @@ fn run_pil(args: &RunArgs) -> anyhow::Result<()> {
     // Checked here too, so that a scenario too long for the firmware is a usage error.
     let scenario = Scenario::load(&args.scenario, &args.set)?;
     pil::check_duration(&scenario).map_err(|e| UsageError(e.to_string()))?;
-    if !scenario.telecommand.is_empty() {
-        return Err(UsageError(
-            "--pil: the PIL link does not carry telecommands yet (run the scenario without --pil)"
-                .to_string(),
-        )
-        .into());
-    }
     if scenario.controller.law != crate::scenario::LawName::Paper {
         return Err(UsageError(format!(
             "--pil flies the flight firmware, whose law is the paper's: controller.law = {:?} \

@@ -193,7 +193,7 @@ pub fn run_stepper<T: Real, S: Stepper<T> + ?Sized>(
         }
         let last = tick == total || history.spool_overrun.is_some();
         let recorded = tick % every == 0 || last;
-        history.telemetry.extend(stepper.take_telemetry(recorded));
+        history.telemetry.extend(stepper.take_telemetry(recorded)?);
         if recorded {
             history.samples.push(sample(&obs, t_s, &out));
             if let Some(e) = obs.elastic {

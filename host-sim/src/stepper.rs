@@ -33,7 +33,7 @@ pub enum SimError {
     #[error("{0}")]
     Elastic(#[from] ElasticError),
     /// The scenario lists telecommands and the controller in the loop has no PUS services to
-    /// take them (the f64 evaluation, a tension law, the PIL link).
+    /// take them (the f64 evaluation, a tension law).
     #[error("the controller in the loop takes no telecommands (only the flight controller linked into the simulator does)")]
     NoTelecommands,
     /// The plant state stopped being finite (a physically impossible run).
@@ -102,9 +102,9 @@ pub trait Stepper<T> {
 
     /// The telemetry packets the unit sent since the last call, in order, with the
     /// housekeeping of the last step if `housekeeping` (none without PUS services).
-    fn take_telemetry(&mut self, housekeeping: bool) -> Vec<Vec<u8>> {
+    fn take_telemetry(&mut self, housekeeping: bool) -> Result<Vec<Vec<u8>>, SimError> {
         let _ = housekeeping;
-        Vec::new()
+        Ok(Vec::new())
     }
 
     /// The reel command of the period `out` was decided for: the rate command and its

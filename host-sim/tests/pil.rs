@@ -33,6 +33,7 @@ use std::sync::Mutex;
 use tss_reel::config::RateSource;
 use tss_reel::controller::{Config, Controller, Input, Output};
 use tss_reel::link::{self, ParamTable, PARAMS};
+use tss_reel::pus::{read_telemetry, Stage, Telemetry};
 use tss_sim::history::History;
 use tss_sim::pil::{self, Injected, PilError, PilLink, PilReport};
 use tss_sim::scenario::Scenario;
@@ -413,4 +414,171 @@ fn heavy_link_faults_at_the_start_and_the_end_are_counted_exactly() {
         total.dropped > 0 && total.corrupted > 0 && total.duplicated > 0 && total.reordered > 0,
         "every kind of fault injected: {total:?}"
     );
+}
+
+/// The telemetry packets of a run by PUS service and subtype, in order of first appearance.
+fn packet_counts(h: &History) -> Vec<((u8, u8), u32)> {
+    let mut counts: Vec<((u8, u8), u32)> = Vec::new();
+    for raw in &h.telemetry {
+        let kind = match read_telemetry(raw)
+            .expect("the unit's packets decode")
+            .telemetry
+        {
+            Telemetry::Verification { stage, failure, .. } => {
+                let base = match stage {
+                    Stage::Acceptance => 1,
+                    Stage::Start => 3,
+                    Stage::Completion => 7,
+                };
+                (1, base + u8::from(failure.is_some()))
+            }
+            Telemetry::Housekeeping(_) => (3, 25),
+            Telemetry::Event { severity, .. } => (5, severity as u8),
+        };
+        match counts.iter_mut().find(|(k, _)| *k == kind) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((kind, 1)),
+        }
+    }
+    counts
+}
+
+/// Flies the commanded `sc` on the host and in PIL: the histories bit for bit, and the
+/// telemetry packet for packet, byte for byte (the firmware's PUS services are the host
+/// unit's). Returns the PIL run.
+fn assert_commanded_pil_is_the_host(sc: &Scenario, elf: &Path, name: &str) -> History {
+    let host = sim::run(sc, &[], &mut |_| {}).unwrap();
+    let (pil, report) = run_pil(sc, elf, name);
+    eprint!("{}", report.render());
+    assert_eq!(
+        report.spurious_timeouts, 0,
+        "the host stalled past the firmware's timeout"
+    );
+    assert!(report.consistent());
+    assert_identical(&host, &pil);
+    let counts = packet_counts(&pil);
+    eprintln!(
+        "{name}: {} telecommands, {} telemetry packets by (service, subtype): {counts:?}",
+        report.telecommands, report.telemetry_packets
+    );
+    assert_eq!(report.telecommands as usize, sc.telecommand.len());
+    assert_eq!(report.telemetry_packets as usize, pil.telemetry.len());
+    assert_eq!(counts, packet_counts(&host));
+    assert_eq!(pil.telemetry.len(), host.telemetry.len());
+    for (i, (p, h)) in pil.telemetry.iter().zip(&host.telemetry).enumerate() {
+        assert_eq!(
+            p,
+            h,
+            "telemetry packet {i} differs: {:?}",
+            read_telemetry(p)
+        );
+    }
+    // A housekeeping packet for every recorded period, as history.csv has a row.
+    let hk = counts.iter().find(|(k, _)| *k == (3, 25)).map(|(_, n)| *n);
+    assert_eq!(hk, Some(pil.samples.len() as u32));
+    pil
+}
+
+/// The verification reports of a run: (request sequence count, subtype).
+fn verification(h: &History) -> Vec<(u16, u8)> {
+    h.telemetry
+        .iter()
+        .filter_map(|raw| match read_telemetry(raw)?.telemetry {
+            Telemetry::Verification {
+                request,
+                stage,
+                failure,
+            } => {
+                let base = match stage {
+                    Stage::Acceptance => 1,
+                    Stage::Start => 3,
+                    Stage::Completion => 7,
+                };
+                Some((
+                    request.sequence & 0x3fff,
+                    base + u8::from(failure.is_some()),
+                ))
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// The commanded missions of `scenarios/` with the flight configuration, their commands moved
+/// early: `paper-commanded.toml` (hold, resume, a refused resume) and `faults-commanded.toml`
+/// (a hold and its resume, a sensor dropout, the orbit-rate fault and an abort after it) on
+/// the rigid plant, `paper-elastic-commanded.toml` (hold, resume, abort) on the elastic one.
+/// The telecommands travel to the firmware as PUS packets over the link and its PUS services
+/// answer: history and telemetry as the host-linked unit's, bit for bit.
+#[test]
+fn commanded_missions_fly_in_pil_as_on_the_host() {
+    let Some(elf) = firmware() else { return };
+    let _one = QEMU.lock().unwrap_or_else(|e| e.into_inner());
+    const HOLD_RESUME: &str =
+        r#"telecommand=[{ at_s = 60.0, command = "hold" }, { at_s = 150.0, command = "resume" }"#;
+
+    let refused = format!(r#"{HOLD_RESUME}, {{ at_s = 200.0, command = "resume" }}]"#);
+    let sc = scenario_from(
+        "paper-commanded.toml",
+        &[
+            &FLIGHT_SENSORS[..],
+            &["simulation.duration_s=300", &refused],
+        ]
+        .concat(),
+    );
+    let pil = assert_commanded_pil_is_the_host(&sc, &elf, "paper-commanded");
+    let held = pil.samples.iter().filter(|s| s.t_s > 70.0 && s.t_s < 150.0);
+    assert!(
+        held.clone().all(|s| s.length_rate_mps == 0.0),
+        "held at rest"
+    );
+    assert_eq!(
+        verification(&pil),
+        [
+            (0, 1),
+            (0, 3),
+            (0, 7),
+            (1, 1),
+            (1, 3),
+            (1, 7),
+            (2, 1),
+            (2, 4)
+        ],
+        "hold and resume completed, the second resume refused (not held)"
+    );
+
+    let aborted = format!(r#"{HOLD_RESUME}, {{ at_s = 210.0, command = "abort" }}]"#);
+    let sc = scenario_from(
+        "faults-commanded.toml",
+        &[
+            &FLIGHT_SENSORS[..],
+            &[
+                "simulation.duration_s=300",
+                "faults.dropout=[{ from_s = 100.0, until_s = 110.0 }]",
+                r#"faults.corrupt=[{ sensor = "orbit_rate", from_s = 200.0, until_s = 202.0, value = inf }]"#,
+                &aborted,
+            ],
+        ]
+        .concat(),
+    );
+    let pil = assert_commanded_pil_is_the_host(&sc, &elf, "faults-commanded");
+    assert_eq!(pil.faults.missing_ticks, 10, "the dropout flew");
+    assert_eq!(verification(&pil).iter().filter(|v| v.1 == 7).count(), 3);
+    let end = pil.samples.last().unwrap();
+    assert_eq!(end.length_rate_mps, 0.0, "aborted to rest: {end:?}");
+
+    let sc = scenario_from(
+        "paper-elastic-commanded.toml",
+        &[
+            &FLIGHT_SENSORS[..],
+            &["simulation.duration_s=240", &aborted],
+        ]
+        .concat(),
+    );
+    assert!(sim::controller_config::<f32>(&sc)
+        .unwrap()
+        .tension_loop
+        .is_some());
+    let pil = assert_commanded_pil_is_the_host(&sc, &elf, "paper-elastic-commanded");
+    assert_eq!(verification(&pil).iter().filter(|v| v.1 == 7).count(), 3);
 }

@@ -15,6 +15,16 @@
 //! closes the run: the firmware answers with a `Report` (its link counters and the digest of
 //! its commands), logs them, and exits with success.
 //!
+//! **Telecommands and telemetry.** Before a period's sample the plant may send the on-board
+//! computer's telecommands, each a CCSDS/PUS packet in a `Packet` frame: the firmware hands
+//! each to its PUS services ([`tss_reel::pus::Services`], the code the simulator's unit runs),
+//! which verify it and execute it or hand it to the controller for the period boundary, and
+//! sends every telemetry packet they produce back in a `Packet` frame at once: the verification
+//! reports as the telecommand is taken, the completion reports and the events after the step
+//! (before the `Command`), and the housekeeping of a period when the plant asks for it with a
+//! `Collect` frame (it records that period). So the telemetry comes from the MCU, in the order
+//! and with the contents of a host-linked run.
+//!
 //! **Time.** The plant is the clock: the tick number in the sample frame is the authority, and
 //! the firmware never runs ahead of the plant, because it blocks (bounded) on each sample.
 //! SysTick keeps running and serves as the timeout: a sample that has not arrived after
@@ -38,8 +48,10 @@ use tss_reel::controller::{Config, Controller, Input, Output};
 use tss_reel::hal::{ErrorKind, ErrorType, ReelDrive};
 use tss_reel::link::{
     self, Command, FrameReader, Gate, Hello, LinkCounters, LinkError, LoadVerdict, Loaded, Message,
-    ParamTable, Report, Sample, SampleGate, SampleStatus, MAX_WIRE_LEN, NO_PARAM, SAMPLE_VALID,
+    Packet, ParamTable, Report, Sample, SampleGate, SampleStatus, MAX_WIRE_LEN, NO_PARAM,
+    SAMPLE_VALID,
 };
+use tss_reel::pus::Services;
 
 use super::clock::{self, ControlClock};
 use super::exit;
@@ -61,6 +73,11 @@ pub const MAX_SILENT_PERIODS: u32 = 600;
 /// Largest number of UART polls in one wait: a bound on the loop should SysTick stop.
 const MAX_POLLS_PER_WAIT: u32 = 1 << 28;
 
+/// Most telecommand and housekeeping-request frames taken while one period's sample is
+/// awaited; beyond them the period is a timeout (the PUS flood limit,
+/// `pus::MAX_TCS_PER_PERIOD`, refuses all but the first few telecommands long before).
+const MAX_FRAMES_PER_PERIOD: u32 = 64;
+
 /// What one wait on the link produced.
 // The parameter table arrives once a run; there is no heap to box it in.
 #[allow(clippy::large_enum_variant)]
@@ -77,6 +94,10 @@ enum Received {
     /// A parameter table and its frame's sequence number (before the first period; later ones
     /// are counted as the wrong kind).
     Params(ParamTable, u32),
+    /// A telecommand packet (after the table is loaded).
+    Telecommand(Packet),
+    /// The plant asks for the housekeeping of the period `tick`.
+    Collect(u32),
 }
 
 /// The controller's input of a valid sample frame for `tick`, field by field.
@@ -119,6 +140,17 @@ impl Link {
             self.send_errors = self.send_errors.saturating_add(1);
         }
         sent
+    }
+
+    /// Sends the telemetry packet `tm` in a `Packet` frame (a failure is counted in
+    /// `send_errors` and logged at the end).
+    fn send_packet(&mut self, tm: &[u8]) {
+        match Packet::new(tm) {
+            Some(p) => {
+                let _ = self.send(&Message::Packet(p));
+            }
+            None => self.send_errors = self.send_errors.saturating_add(1),
+        }
     }
 
     /// Waits for the sample of period `awaited` (or, `loading`, a parameter table), at most
@@ -171,13 +203,22 @@ impl Link {
                     return Received::End(e.ticks);
                 }
                 Message::Params(table) if loading => return Received::Params(table, frame.seq),
+                Message::Packet(p) if !loading => {
+                    self.gate.other(frame.seq, &mut self.counters);
+                    return Received::Telecommand(p);
+                }
+                Message::Collect(c) if !loading => {
+                    self.gate.other(frame.seq, &mut self.counters);
+                    return Received::Collect(c.tick);
+                }
                 Message::Sample(_)
                 | Message::Hello(_)
                 | Message::Command(_)
                 | Message::Report(_)
                 | Message::Params(_)
                 | Message::Loaded(_)
-                | Message::Packet(_) => {
+                | Message::Packet(_)
+                | Message::Collect(_) => {
                     self.counters.count_error(LinkError::WrongKind);
                     defmt::warn!(
                         "link: unexpected frame kind discarded (seq={=u32})",
@@ -188,6 +229,68 @@ impl Link {
         }
         self.counters.timeouts = self.counters.timeouts.saturating_add(1);
         Received::Timeout
+    }
+}
+
+/// The reel unit: the flight controller behind its PUS services, as the simulator's
+/// (`host-sim/src/obc.rs`), its telemetry going out over the link.
+struct Unit {
+    controller: Controller<f32>,
+    services: Services,
+    /// The last step's sample, for its housekeeping.
+    last_input: Option<Input<f32>>,
+}
+
+impl Unit {
+    /// Waits for the sample of period `awaited` ([`Link::receive`]), taking the telecommands
+    /// and housekeeping requests that come before it (at most [`MAX_FRAMES_PER_PERIOD`]).
+    fn await_sample(&mut self, link: &mut Link, awaited: u32) -> Received {
+        for _ in 0..MAX_FRAMES_PER_PERIOD {
+            match link.receive(awaited, false) {
+                Received::Telecommand(tc) => {
+                    self.services
+                        .telecommand(tc.bytes(), &mut self.controller, &mut |tm| {
+                            link.send_packet(tm)
+                        });
+                }
+                Received::Collect(tick) => {
+                    let last = self.controller.output().tick;
+                    if tick != last {
+                        defmt::warn!(
+                            "t={=u32} link: housekeeping asked for tick {=u32}",
+                            last,
+                            tick
+                        );
+                    }
+                    self.services.report_housekeeping(
+                        &self.controller,
+                        self.last_input.as_ref(),
+                        &mut |tm| link.send_packet(tm),
+                    );
+                }
+                other => return other,
+            }
+        }
+        defmt::warn!(
+            "t={=u32} link: more than {=u32} frames before the sample",
+            awaited,
+            MAX_FRAMES_PER_PERIOD
+        );
+        link.counters.timeouts = link.counters.timeouts.saturating_add(1);
+        Received::Timeout
+    }
+
+    /// Steps the controller for `tick` on `reading` (or without a sample) and sends the
+    /// step's telemetry: the completion of a mode command it applied, and its events.
+    fn step(&mut self, link: &mut Link, tick: u32, reading: Option<&Sample>) -> Output<f32> {
+        self.last_input = reading.map(|s| input(tick, s));
+        let output = match &self.last_input {
+            Some(x) => *self.controller.step(x),
+            None => *self.controller.step_missing(tick),
+        };
+        self.services
+            .report_events(&mut self.controller, &mut |tm| link.send_packet(tm));
+        output
     }
 }
 
@@ -243,7 +346,11 @@ pub fn run(_clock: ControlClock) -> ! {
         defmt::error!("PIL: could not send the hello frame");
         exit::failure();
     }
-    let mut controller = load(&mut link);
+    let mut unit = Unit {
+        controller: load(&mut link),
+        services: Services::new(),
+        last_input: None,
+    };
 
     // The plant's first sample is that of tick 0: a lost first frame is a missing sample like
     // any other (the firmware times out and steps without it), never a wait for ever.
@@ -253,10 +360,11 @@ pub fn run(_clock: ControlClock) -> ! {
     let mut digest = link::fnv1a_start();
     let mut dropouts = 0u32;
     for _ in 0..MAX_TICKS {
-        let (tick, status, reading) = match link.receive(awaited, false) {
+        let (tick, status, reading) = match unit.await_sample(&mut link, awaited) {
             Received::End(ticks) => finish(&mut link, ticks, count, digest, dropouts),
-            // Not asked for: `receive` counts a late table as the wrong kind.
-            Received::Params(..) => continue,
+            // Not asked for: `receive` counts a late table as the wrong kind; `await_sample`
+            // takes the telecommands and housekeeping requests.
+            Received::Params(..) | Received::Telecommand(_) | Received::Collect(_) => continue,
             Received::Sample(s) => {
                 silent = 0;
                 if s.tick > awaited {
@@ -288,13 +396,10 @@ pub fn run(_clock: ControlClock) -> ! {
                 }
             }
         };
-        let output = match reading {
-            Ok(s) => *controller.step(&input(tick, &s)),
-            Err(_) => {
-                dropouts = dropouts.saturating_add(1);
-                *controller.step_missing(tick)
-            }
-        };
+        if reading.is_err() {
+            dropouts = dropouts.saturating_add(1);
+        }
+        let output = unit.step(&mut link, tick, reading.as_ref().ok());
         let mut reel = CommandLink {
             link: &mut link,
             status,
@@ -328,8 +433,13 @@ fn load(link: &mut Link) -> Controller<f32> {
         let (table, seq) = match link.receive(0, true) {
             Received::Params(t, seq) => (t, seq),
             Received::End(ticks) => finish(link, ticks, 0, link::fnv1a_start(), 0),
-            // (`receive` returns no sample while loading: it counts one as the wrong kind.)
-            Received::Timeout | Received::Corrupted(_) | Received::Sample(_) => {
+            // (`receive` returns no sample, telecommand or housekeeping request while loading:
+            // it counts them as the wrong kind.)
+            Received::Timeout
+            | Received::Corrupted(_)
+            | Received::Sample(_)
+            | Received::Telecommand(_)
+            | Received::Collect(_) => {
                 silent = silent.saturating_add(1);
                 if silent > MAX_SILENT_PERIODS {
                     defmt::error!("PIL: no parameter table for {=u32} periods", silent);

@@ -25,8 +25,9 @@ pub enum Gate {
 pub struct SampleGate {
     /// Sequence number and tick of the newest sample frame seen (`None`: none yet).
     last: Option<(u32, u32)>,
-    /// The sequence number the sender's first sample frame carries.
-    first_seq: u32,
+    /// The sequence number the sender's next new frame carries (of any kind: telecommand
+    /// packets and housekeeping requests are numbered in the same sequence as the samples).
+    next_seq: u32,
 }
 
 impl SampleGate {
@@ -35,19 +36,20 @@ impl SampleGate {
         Self::from_seq(0)
     }
 
-    /// A gate whose sender numbers its first sample frame `first_seq` (the frames before it,
-    /// such as the parameter table, were of other kinds).
+    /// A gate whose sender numbers its next frame `first_seq` (the frames before it, such as
+    /// the parameter table, were of other kinds).
     pub const fn from_seq(first_seq: u32) -> Self {
         Self {
             last: None,
-            first_seq,
+            next_seq: first_seq,
         }
     }
 
-    /// The sequence number the next new frame should carry.
-    fn expected_seq(&self) -> u32 {
-        self.last
-            .map_or(self.first_seq, |(seq, _)| seq.saturating_add(1))
+    /// Counts the frames lost before the frame `seq` as gaps, and expects the one after it.
+    fn seen(&mut self, seq: u32, counters: &mut LinkCounters) {
+        let gap = seq.saturating_sub(self.next_seq);
+        counters.seq_gaps = counters.seq_gaps.saturating_add(gap);
+        self.next_seq = self.next_seq.max(seq.saturating_add(1));
     }
 
     /// Judges a valid sample frame `seq`/`sample` while the receiver waits for tick `awaited`;
@@ -69,9 +71,8 @@ impl SampleGate {
                 return Gate::OutOfOrder;
             }
         }
-        let gap = seq.saturating_sub(self.expected_seq());
-        counters.seq_gaps = counters.seq_gaps.saturating_add(gap);
         // Seen, so it is no gap, whether or not it is used.
+        self.seen(seq, counters);
         self.last = Some((seq, sample.tick));
         if sample.tick < awaited {
             counters.out_of_order = counters.out_of_order.saturating_add(1);
@@ -81,10 +82,15 @@ impl SampleGate {
         Gate::Accept(sample)
     }
 
+    /// A valid frame `seq` of another kind from the same sender (a telecommand packet, a
+    /// housekeeping request): the frames lost before it are gaps.
+    pub fn other(&mut self, seq: u32, counters: &mut LinkCounters) {
+        self.seen(seq, counters);
+    }
+
     /// The sender's [`End`](super::End) frame, number `end_seq`, closed the run: counts the frames lost
     /// after the last one seen (all of them if none arrived).
     pub fn close(&mut self, end_seq: u32, counters: &mut LinkCounters) {
-        let gap = end_seq.saturating_sub(self.expected_seq());
-        counters.seq_gaps = counters.seq_gaps.saturating_add(gap);
+        self.seen(end_seq, counters);
     }
 }

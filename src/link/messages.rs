@@ -142,6 +142,17 @@ pub struct End {
     pub ticks: u32,
 }
 
+/// `Collect`: the plant records the period `tick` that the firmware has just answered, and
+/// asks for its housekeeping (PUS TM\[3,25\] at the collection interval, the plant's output
+/// interval); the firmware answers with that one telemetry packet in a `Packet` frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Collect {
+    /// The period whose step the housekeeping reports (the last one the firmware answered).
+    #[serde(with = "postcard::fixint::le")]
+    pub tick: u32,
+}
+
 /// What a receiver saw on the link (each field a count of frames or periods).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -300,7 +311,9 @@ pub enum Message {
     /// Kind 7, both ways: a PUS telecommand plant → firmware, a PUS telemetry packet
     /// firmware → plant.
     Packet(Packet),
+    /// Kind 8, plant → firmware.
+    Collect(Collect),
 }
 
 /// Number of message kinds (kind bytes `0 .. KINDS`).
-pub const KINDS: u8 = 8;
+pub const KINDS: u8 = 9;

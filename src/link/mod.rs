@@ -20,7 +20,7 @@
 //! 1       4     seq      u32       sender's frame counter from 0, +1 per new frame (a repeat
 //!                                  keeps it)
 //! 5       1     kind     u8        0 Hello, 1 Sample, 2 Command, 3 End, 4 Report, 5 Params,
-//!                                  6 Loaded, 7 Packet
+//!                                  6 Loaded, 7 Packet, 8 Collect
 //! 6       n     body               the kind's fields, in declaration order (`messages.rs`)
 //! 6+n     4     crc      u32       CRC-32/ISO-HDLC over bytes 0 .. 6+n
 //! ```
@@ -59,13 +59,24 @@
 //!         PUS telecommand (before the period's Sample), firmware → plant a PUS telemetry
 //!         packet (before the period's Command); len 0 or beyond MAX_PACKET_LEN is
 //!         LinkError::Malformed, fewer bytes than len LinkError::Truncated
+//! Collect (plant → firmware, after a period's Command when the plant records that period,
+//!         n = 4)
+//!         tick u32 (the period just answered); the firmware answers with one Packet, the
+//!         housekeeping TM[3,25] of that period's step
 //! ```
+//!
+//! A period with telecommands is, on the wire: plant → firmware the telecommands' `Packet`
+//! frames, then the `Sample`; firmware → plant each telecommand's verification reports as it
+//! takes it, then after its step the completion reports and events, then the `Command`; and,
+//! if the plant records the period, plant → firmware `Collect` and firmware → plant the
+//! housekeeping. Every frame the plant sends carries the next number of its one sequence, so
+//! the receiver's [`SampleGate`] counts a lost frame of any kind as a gap.
 //!
 //! `opt` is an optional f32 (postcard's `Option`): one byte 0 (absent), or 1 followed by the
 //! f32 (any other tag byte is [`LinkError::Malformed`]). Version 1 had no options: a sample
 //! carried α and α̇ always, and no reel rate, tension or true anomaly; a command no NIS.
 //! Version 2 had no `Params` and `Loaded`: the firmware flew its built-in configuration.
-//! Version 3 had no `Packet`: nobody could command the firmware.
+//! Version 3 had no `Packet` and `Collect`: nobody could command the firmware.
 //!
 //! The largest frame (a Packet with the longest telecommand, the parameter-table load) is
 //! 6 + 2 + 297 + 4 = 309 bytes decoded, [`MAX_WIRE_LEN`] on the wire.
@@ -293,8 +304,8 @@ pub use digest::{config_digest, fnv1a, fnv1a_f32, fnv1a_start};
 pub use error::LinkError;
 pub use gate::{Gate, SampleGate};
 pub use messages::{
-    Command, End, Hello, LinkCounters, LoadVerdict, Loaded, Message, Report, Sample, SampleStatus,
-    KINDS, NO_PARAM, SAMPLE_MISSING, SAMPLE_VALID,
+    Collect, Command, End, Hello, LinkCounters, LoadVerdict, Loaded, Message, Report, Sample,
+    SampleStatus, KINDS, NO_PARAM, SAMPLE_MISSING, SAMPLE_VALID,
 };
 pub use packet::{Packet, MAX_PACKET_LEN};
 pub use params::{
