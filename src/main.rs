@@ -61,7 +61,19 @@ fn main() -> ! {
     if firmware::cmdline::mode() == firmware::cmdline::Mode::Pil {
         firmware::pil::run(ControlClock::start(core.SYST, mission::CONTROL_PERIOD_MS));
     }
-    let mut clock = ControlClock::start(core.SYST, reel::INNER_PERIOD_MS);
+    replay(core.SYST)
+}
+
+/// The built-in replay: the flight controller on the replayed sensors at the law's rate, the
+/// speed loop driving the simulated reel every inner tick, until the mission ends.
+///
+/// Not inlined into [`main`]: its state (the mission and the reel, about 4 KB of frame) would
+/// otherwise be reserved on the stack under the processor-in-the-loop mission as well
+/// (`scripts/size-check` measures both modes).
+#[cfg(target_os = "none")]
+#[inline(never)]
+fn replay(syst: cortex_m::peripheral::SYST) -> ! {
+    let mut clock = ControlClock::start(syst, reel::INNER_PERIOD_MS);
     let drum = core::cell::RefCell::new(reel::sim_drum());
     let mut reel = reel::Reel::new(&drum);
     let mut mission = mission::Mission::new();

@@ -5,7 +5,8 @@
 //! built-in configuration `Config::flight()`, its period and sample timeout), then waits for the
 //! plant's `Params` frame: the controller configuration to fly, as the parameter table
 //! ([`tss_reel::link::ParamTable`]). It builds the controller from it, so the core's own
-//! validation ([`Config::validate`]) judges the table, and answers with `Loaded`: the digest of
+//! validation ([`Config::validate`]) judges the table, replaces the controller of its built-in
+//! configuration by it whole, and answers with `Loaded`: the digest of
 //! the configuration it now flies, or why it refused it (the word at fault and the core's rule;
 //! a refused table changes nothing, and the firmware waits for another). Then, for every control
 //! period: waits for the plant's `Sample` frame, steps the controller on it (the frame carries
@@ -244,15 +245,14 @@ struct Unit {
 impl Unit {
     /// Waits for the sample of period `awaited` ([`Link::receive`]), taking the telecommands
     /// and housekeeping requests that come before it (at most [`MAX_FRAMES_PER_PERIOD`]).
+    ///
+    /// Not inlined into [`run`]: the frames it receives would otherwise stay reserved in
+    /// `run`'s frame under the parameter-table load as well (the PIL-mode stack).
+    #[inline(never)]
     fn await_sample(&mut self, link: &mut Link, awaited: u32) -> Received {
         for _ in 0..MAX_FRAMES_PER_PERIOD {
             match link.receive(awaited, false) {
-                Received::Telecommand(tc) => {
-                    self.services
-                        .telecommand(tc.bytes(), &mut self.controller, &mut |tm| {
-                            link.send_packet(tm)
-                        });
-                }
+                Received::Telecommand(tc) => self.telecommand(link, &tc),
                 Received::Collect(tick) => {
                     let last = self.controller.output().tick;
                     if tick != last {
@@ -278,6 +278,19 @@ impl Unit {
         );
         link.counters.timeouts = link.counters.timeouts.saturating_add(1);
         Received::Timeout
+    }
+
+    /// Hands the telecommand `tc` to the PUS services and sends their reports.
+    ///
+    /// Not inlined into [`Unit::await_sample`]: the decoded telecommand (a parameter table, at
+    /// most) would otherwise stay reserved on the stack under every frame received (the
+    /// PIL-mode stack, `scripts/size-check`).
+    #[inline(never)]
+    fn telecommand(&mut self, link: &mut Link, tc: &Packet) {
+        self.services
+            .telecommand(tc.bytes(), &mut self.controller, &mut |tm| {
+                link.send_packet(tm)
+            });
     }
 
     /// Steps the controller for `tick` on `reading` (or without a sample) and sends the
@@ -347,10 +360,11 @@ pub fn run(_clock: ControlClock) -> ! {
         exit::failure();
     }
     let mut unit = Unit {
-        controller: load(&mut link),
+        controller: builtin_controller(),
         services: Services::new(),
         last_input: None,
     };
+    load(&mut link, &mut unit.controller);
 
     // The plant's first sample is that of tick 0: a lost first frame is a missing sample like
     // any other (the firmware times out and steps without it), never a wait for ever.
@@ -423,16 +437,23 @@ pub fn run(_clock: ControlClock) -> ! {
     exit::failure()
 }
 
-/// Waits for the plant's parameter table and builds the controller from it, answering each
-/// table with `Loaded`; a refused table changes nothing and the next one is awaited. The plant
-/// gone silent for [`MAX_SILENT_PERIODS`], or ending the run before a table was accepted, ends
-/// the run. The plant's first sample frame is the one after the accepted table.
-fn load(link: &mut Link) -> Controller<f32> {
+/// Waits for the plant's parameter table and replaces `controller` by the one built from it,
+/// answering each table with `Loaded`; a refused table changes nothing and the next one is
+/// awaited. The plant gone silent for [`MAX_SILENT_PERIODS`], or ending the run before a table
+/// was accepted, ends the run. The plant's first sample frame is the one after the accepted
+/// table.
+///
+/// Not inlined into [`run`], and the table judged in [`judge`]: the controller a table builds
+/// is on the stack only while it is judged, not under every wait for a frame (the PIL-mode
+/// stack, `scripts/size-check`).
+#[inline(never)]
+fn load(link: &mut Link, controller: &mut Controller<f32>) {
     let mut silent = 0u32;
     loop {
-        let (table, seq) = match link.receive(0, true) {
-            Received::Params(t, seq) => (t, seq),
-            Received::End(ticks) => finish(link, ticks, 0, link::fnv1a_start(), 0),
+        let received = link.receive(0, true);
+        let (table, seq) = match &received {
+            Received::Params(t, seq) => (t, *seq),
+            Received::End(ticks) => finish(link, *ticks, 0, link::fnv1a_start(), 0),
             // (`receive` returns no sample, telecommand or housekeeping request while loading:
             // it counts them as the wrong kind.)
             Received::Timeout
@@ -448,52 +469,79 @@ fn load(link: &mut Link) -> Controller<f32> {
                 continue;
             }
         };
-        let (answer, controller) = match table.to_config() {
-            Err(e) => {
-                defmt::warn!("PIL: parameter table refused: {}", e);
-                let refused = Loaded {
-                    config_digest: 0,
-                    verdict: LoadVerdict::BadTable as u8,
-                    param: e.index(),
-                    rule: 0,
-                };
-                (refused, None)
-            }
-            Ok(cfg) => match Controller::new(cfg) {
-                Err(e) => {
-                    defmt::warn!("PIL: parameter table refused: {}", e);
-                    let refused = Loaded {
-                        config_digest: 0,
-                        verdict: LoadVerdict::Refused as u8,
-                        param: link::param_index(&e).unwrap_or(NO_PARAM),
-                        rule: link::rule_code(e.rule),
-                    };
-                    (refused, None)
-                }
-                Ok(c) => {
-                    let digest = link::config_digest(&cfg);
-                    defmt::info!(
-                        "PIL: parameter table loaded, config digest {=u32:#010x}",
-                        digest
-                    );
-                    let loaded = Loaded {
-                        config_digest: digest,
-                        verdict: LoadVerdict::Accepted as u8,
-                        param: NO_PARAM,
-                        rule: 0,
-                    };
-                    (loaded, Some(c))
-                }
-            },
-        };
-        if link.send(&Message::Loaded(answer)).is_err() {
-            defmt::error!("PIL: could not send the load verdict");
-            exit::failure();
-        }
-        if let Some(c) = controller {
+        let verdict = judge(table, controller);
+        send_verdict(link, verdict);
+        if verdict.verdict == LoadVerdict::Accepted as u8 {
             link.gate = SampleGate::from_seq(seq.wrapping_add(1));
-            return c;
+            return;
         }
+    }
+}
+
+/// The controller of the built-in configuration (`Config::flight`), flown until the plant's
+/// table replaces it ([`load`]).
+///
+/// Not inlined into [`run`]: the controller is built in this frame and moved into `run`'s;
+/// inlined, both would stay reserved for the whole mission (the PIL-mode stack).
+#[inline(never)]
+fn builtin_controller() -> Controller<f32> {
+    match Controller::new(Config::flight()) {
+        Ok(c) => c,
+        Err(e) => {
+            defmt::error!("PIL: the core refuses the built-in configuration: {}", e);
+            exit::failure()
+        }
+    }
+}
+
+/// Judges `table` by the core's validation (`Controller::new`): accepted, the controller built
+/// from it replaces `controller` whole; refused, nothing changes. Returns the answer.
+#[inline(never)]
+fn judge(table: &ParamTable, controller: &mut Controller<f32>) -> Loaded {
+    let cfg = match table.to_config() {
+        Ok(cfg) => cfg,
+        Err(e) => {
+            defmt::warn!("PIL: parameter table refused: {}", e);
+            return Loaded {
+                config_digest: 0,
+                verdict: LoadVerdict::BadTable as u8,
+                param: e.index(),
+                rule: 0,
+            };
+        }
+    };
+    match Controller::new(cfg) {
+        Ok(c) => {
+            *controller = c;
+            let digest = link::config_digest(controller.config());
+            defmt::info!(
+                "PIL: parameter table loaded, config digest {=u32:#010x}",
+                digest
+            );
+            Loaded {
+                config_digest: digest,
+                verdict: LoadVerdict::Accepted as u8,
+                param: NO_PARAM,
+                rule: 0,
+            }
+        }
+        Err(e) => {
+            defmt::warn!("PIL: parameter table refused: {}", e);
+            Loaded {
+                config_digest: 0,
+                verdict: LoadVerdict::Refused as u8,
+                param: link::param_index(&e).unwrap_or(NO_PARAM),
+                rule: link::rule_code(e.rule),
+            }
+        }
+    }
+}
+
+/// Sends the `Loaded` answer to a parameter table; the run ends if it cannot be sent.
+fn send_verdict(link: &mut Link, verdict: Loaded) {
+    if link.send(&Message::Loaded(verdict)).is_err() {
+        defmt::error!("PIL: could not send the load verdict");
+        exit::failure();
     }
 }
 

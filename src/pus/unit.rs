@@ -20,7 +20,9 @@ use spacepackets::CcsdsPacket;
 use crate::controller::{
     Controller, Event, EventKind, Health, Input, Mode, RateSource, TensionLoopMode,
 };
-use crate::link::{fault_code, health_code, param_index, phase_code, rule_code, NO_PARAM};
+use crate::link::{
+    fault_code, health_code, param_index, phase_code, rule_code, ParamTable, NO_PARAM,
+};
 
 use super::{
     decode, telemetry_packet, verification_report, Failure, RequestId, Stage, Telecommand, APID,
@@ -494,19 +496,9 @@ impl Services {
                 self.time_offset = t.wrapping_sub(next);
                 Ok(true)
             }
-            Telecommand::LoadParams(table) if !self.started => table
-                .to_config()
-                .map_err(|e| Failure::TableShape(e.index()))
-                .and_then(|cfg| {
-                    Controller::new(cfg).map_err(|e| Failure::TableRefused {
-                        word: param_index(&e).unwrap_or(NO_PARAM),
-                        rule: rule_code(e.rule),
-                    })
-                })
-                .map(|new| {
-                    *ctl = new;
-                    true
-                }),
+            Telecommand::LoadParams(table) if !self.started => {
+                load_table(&table, ctl).map(|()| true)
+            }
             Telecommand::LoadParams(_) => Err(Failure::TooLate),
         };
         match started {
@@ -588,6 +580,29 @@ impl Services {
             self.tm_seq = self.tm_seq.wrapping_add(1) & 0x3fff;
             emit(out.get(..n).unwrap_or(&[]));
         }
+    }
+}
+
+/// The parameter-table load: `table` judged by the core's validation (`Controller::new`)
+/// and, accepted, the controller built from it replaces `ctl` whole; refused, nothing changes.
+///
+/// Not inlined into [`Services::telecommand`]: the controller it builds would otherwise be
+/// reserved on the stack under every telecommand's reports (on the reel MCU, the frames that
+/// send them over the link), not only under a table load.
+#[inline(never)]
+fn load_table(table: &ParamTable, ctl: &mut Controller<f32>) -> Result<(), Failure> {
+    let cfg = table
+        .to_config()
+        .map_err(|e| Failure::TableShape(e.index()))?;
+    match Controller::new(cfg) {
+        Ok(new) => {
+            *ctl = new;
+            Ok(())
+        }
+        Err(e) => Err(Failure::TableRefused {
+            word: param_index(&e).unwrap_or(NO_PARAM),
+            rule: rule_code(e.rule),
+        }),
     }
 }
 
