@@ -21,6 +21,10 @@
 //!   `heavy_link_faults_at_the_start_and_the_end_are_counted_exactly` (issue 16 §4): short runs
 //!   with every sample frame faulted (all four kinds, several seeds), the first and the last
 //!   frames among them: the link starts, every period flies, and both ends agree exactly.
+//! - `commanded_missions_fly_in_pil_as_on_the_host`: the commanded missions of `scenarios/`
+//!   with the flight configuration, shortened, their telecommands moved early: the telecommands
+//!   travel to the firmware as PUS packets and its PUS services answer over the link; history
+//!   and telemetry equal the host-linked run's, and so do the packet counts.
 //!
 //! They need the firmware ELF (`cargo fw-build`, or `TSS_FIRMWARE_ELF`) and `qemu-system-arm`
 //! and `defmt-print` on PATH. Without them each test prints why and passes, unless
