@@ -154,8 +154,9 @@ fn assert_identical(a: &History, b: &History) {
     assert_eq!(a.faults, b.faults, "fault summaries differ");
 }
 
-/// Flies `sc` on the host and in PIL and checks both bit for bit; returns the PIL report.
-fn assert_pil_is_the_host(sc: &Scenario, elf: &Path, name: &str) -> PilReport {
+/// Flies `sc` on the host and in PIL; the link's report printed and consistent, with no
+/// spurious timeout. Returns the host run, the PIL run and its report.
+fn fly_host_and_pil(sc: &Scenario, elf: &Path, name: &str) -> (History, History, PilReport) {
     let host = sim::run(sc, &[], &mut |_| {}).unwrap();
     let (pil, report) = run_pil(sc, elf, name);
     eprint!("{}", report.render());
@@ -164,6 +165,12 @@ fn assert_pil_is_the_host(sc: &Scenario, elf: &Path, name: &str) -> PilReport {
         "the host stalled past the firmware's timeout"
     );
     assert!(report.consistent());
+    (host, pil, report)
+}
+
+/// Flies `sc` on the host and in PIL and checks both bit for bit; returns the PIL report.
+fn assert_pil_is_the_host(sc: &Scenario, elf: &Path, name: &str) -> PilReport {
+    let (host, pil, report) = fly_host_and_pil(sc, elf, name);
     assert_eq!(report.ticks, pil.faults.ticks);
     assert_eq!(report.status.fresh, report.ticks);
     let d_cmd = max_diff(&host, &pil, |s| s.length_rate_mps);
@@ -451,14 +458,7 @@ fn packet_counts(h: &History) -> Vec<((u8, u8), u32)> {
 /// telemetry packet for packet, byte for byte (the firmware's PUS services are the host
 /// unit's). Returns the PIL run.
 fn assert_commanded_pil_is_the_host(sc: &Scenario, elf: &Path, name: &str) -> History {
-    let host = sim::run(sc, &[], &mut |_| {}).unwrap();
-    let (pil, report) = run_pil(sc, elf, name);
-    eprint!("{}", report.render());
-    assert_eq!(
-        report.spurious_timeouts, 0,
-        "the host stalled past the firmware's timeout"
-    );
-    assert!(report.consistent());
+    let (host, pil, report) = fly_host_and_pil(sc, elf, name);
     assert_identical(&host, &pil);
     let counts = packet_counts(&pil);
     eprintln!(
