@@ -1,14 +1,21 @@
-//! # trace_step: the paper mission's steps, one call each, for instruction traces
+//! # trace_step: the benchmark's steps, one call each, for instruction traces
 //!
-//! Flies `Controller<f32>` (`Config::flight`: the law on the onboard estimator) over the whole 20-hour paper mission (`tss_reel::recordings::mission`)
-//! with one `Controller::step` call per tick and nothing else (the load cell reading the
-//! recorded state's tension, `tss_reel::recordings::load_cell`, as in `examples/bench_step.rs`), so that an execution trace of
-//! QEMU (`tools/trace_profile.py --mission-tick N`) can attribute the instructions of any
-//! mission step, not only those of the firmware's 720-s replay. Prints nothing per step.
+//! Flies `Controller<f32>` (`Config::flight`: the law on the onboard estimator) over the same
+//! inputs as `examples/bench_step.rs`, with one `Controller::step` (or `step_missing`) call per
+//! tick and nothing else, so that an execution trace of QEMU (`tools/trace_profile.py
+//! --mission-tick N`) can attribute the instructions of any step the benchmark times:
+//!
+//! - by default the whole 20-hour paper mission (`tss_reel::recordings::mission`);
+//! - built with `TSS_TRACE_REPLAY=1`, the firmware's 720-s replay (`tss_reel::recordings::replay`)
+//!   with its sensor dropout.
+//!
+//! Each sample carries, as in the benchmark, the encoder's rate (the recorded length's change
+//! over the period), the load cell's tension in the recorded state
+//! (`tss_reel::recordings::load_cell`) and α without α̇. Prints nothing per step.
 //!
 //! Needs the `firmware` feature and the bare-metal target (`required-features` in Cargo.toml):
-//! `cargo build --profile firmware --target thumbv7em-none-eabihf --features firmware --example
-//! trace_step`.
+//! `[TSS_TRACE_REPLAY=1] cargo build --profile firmware --target thumbv7em-none-eabihf --features
+//! firmware --example trace_step`.
 #![no_std]
 #![no_main]
 #![deny(unsafe_code)]
@@ -16,6 +23,20 @@
 use tss_reel::firmware::exit;
 /// The whole paper mission, recorded every 5 s, interpolated to 1 s.
 use tss_reel::recordings::mission;
+/// The firmware's built-in input: the first 720 s of the paper's mission.
+use tss_reel::recordings::replay;
+
+/// Whether this build flies the replay (`TSS_TRACE_REPLAY` set at build time).
+const REPLAY: bool = matches!(option_env!("TSS_TRACE_REPLAY"), Some(v) if !v.is_empty());
+
+/// The replay's sample at `tick`, `None` in its dropout.
+fn replay_sample(tick: u32) -> Option<[f32; 3]> {
+    if (replay::DROPOUT_FROM_TICK..replay::DROPOUT_UNTIL_TICK).contains(&tick) {
+        None
+    } else {
+        replay::SAMPLES.get(tick as usize).copied()
+    }
+}
 
 #[cortex_m_rt::entry]
 fn main() -> ! {
@@ -29,29 +50,39 @@ fn main() -> ! {
         exit::failure();
     };
     let cfg = *ctl.config();
-    for tick in 0..mission::TICKS {
-        let Some(s) = mission::sample(tick) else {
-            black_box(ctl.step_missing(tick));
-            continue;
-        };
-        let x = Input {
+    let (ticks, orbit_rate_radps, sample): (u32, f32, fn(u32) -> Option<[f32; 3]>) = if REPLAY {
+        (
+            replay::SAMPLES.len() as u32,
+            replay::ORBIT_RATE_RADPS,
+            replay_sample,
+        )
+    } else {
+        (mission::TICKS, mission::ORBIT_RATE_RADPS, mission::sample)
+    };
+    let mut previous_length: Option<f32> = None;
+    for tick in 0..ticks {
+        let input = sample(tick).map(|s| Input {
             tick,
             length_m: s[0],
-            reel_rate_mps: None,
+            reel_rate_mps: previous_length.map(|l| (s[0] - l) / cfg.period_s),
             tension_n: load_cell::tension_n(
-                mission::sample,
+                &sample,
                 tick,
                 cfg.period_s,
                 &cfg.masses,
-                mission::ORBIT_RATE_RADPS,
+                orbit_rate_radps,
             ),
             alpha_rad: Some(s[1]),
-            alpha_rate_radps: Some(s[2]),
-            orbit_rate_radps: mission::ORBIT_RATE_RADPS,
+            alpha_rate_radps: None,
+            orbit_rate_radps,
             true_anomaly_rad: 0.0,
+        });
+        previous_length = input.map(|x| x.length_m);
+        match &input {
+            Some(x) => black_box(ctl.step(black_box(x))),
+            None => black_box(ctl.step_missing(black_box(tick))),
         };
-        black_box(ctl.step(black_box(&x)));
     }
-    defmt::info!("trace_step done: {=u32} steps", mission::TICKS);
+    defmt::info!("trace_step done: {=u32} steps", ticks);
     exit::success()
 }

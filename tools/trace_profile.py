@@ -182,6 +182,16 @@ def firmware_tick_pcs(elf, tick):
     return pcs
 
 
+def stage_of(chain):
+    """The step's stage an instruction belongs to: the outermost method of `Controller` in its
+    inlining chain other than the step's own entry points (`step`, `run`, `decide`)."""
+    for fn in reversed(chain):
+        m = re.search(r"Controller<T>>?::(\w+)", fn)
+        if m and m.group(1) not in ("step", "step_missing", "run", "decide"):
+            return m.group(1)
+    return "(the step itself: " + chain[-1] + ")" if chain else "?"
+
+
 def profile(a, pcs, what):
     """Prints the instructions of `pcs` by category, innermost function and source line."""
     # Function extents, to follow calls into functions LLVM kept out of line (libm's sqrtf,
@@ -207,6 +217,7 @@ def profile(a, pcs, what):
         where[pc] = re.sub(r"^.*/(src|examples)/", r"\1/", lines[1]) if len(lines) > 1 else "?"
 
     by_cat, by_fn, by_line = collections.Counter(), collections.Counter(), collections.Counter()
+    by_stage = collections.Counter()
     stack, prev_pc = [], None  # [(start, end, caller's chain)]
     for pc in pcs:
         while stack and not stack[-1][0] <= pc < stack[-1][1]:
@@ -220,12 +231,16 @@ def profile(a, pcs, what):
         cat = next((c for c, p in CATEGORIES if re.search(p, chain)), "other: " + full[-1])
         by_cat[cat] += 1
         by_fn[chains[pc][0]] += 1
+        by_stage[stage_of(full)] += 1
         if re.search(a.within, cat):
             by_line[where[pc] + "  [" + " < ".join(chains[pc][:3]) + "]"] += 1
     total = len(pcs)
     print(f"{a.elf}: {what}")
     for cat, n in by_cat.most_common():
         print(f"  {n:6d}  {100 * n / total:5.1f} %  {cat}")
+    print("by stage of the step (the outermost `Controller` method below run/decide):")
+    for stage, n in by_stage.most_common():
+        print(f"  {n:6d}  {100 * n / total:5.1f} %  {stage}")
     print(f"innermost source functions (top {a.top}):")
     for fn, n in by_fn.most_common(a.top):
         print(f"  {n:6d}  {fn}")
