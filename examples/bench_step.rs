@@ -302,6 +302,9 @@ mod bench {
                 Some(x) => *ctl.step(x),
                 None => *ctl.step_missing(tick),
             };
+            // The events read every period, as the firmware reads them: each step's own events
+            // go into a queue with room (a full one drops them, the cheaper path).
+            while ctl.pop_event().is_some() {}
             r.step.add(cost, tick);
             let p = &mut r.phases[phase_index(out.phase)];
             p.n += 1;

@@ -2,7 +2,7 @@
 //!
 //! Flies `Controller<f32>` (`Config::flight`: the law on the onboard estimator) over the same
 //! inputs as `examples/bench_step.rs`, with one `Controller::step` (or `step_missing`) call per
-//! tick and nothing else, so that an execution trace of QEMU (`tools/trace_profile.py
+//! tick and its events read, so that an execution trace of QEMU (`tools/trace_profile.py
 //! --mission-tick N`) can attribute the instructions of any step the benchmark times:
 //!
 //! - by default the whole 20-hour paper mission (`tss_reel::recordings::mission`);
@@ -82,6 +82,8 @@ fn main() -> ! {
             Some(x) => black_box(ctl.step(black_box(x))),
             None => black_box(ctl.step_missing(black_box(tick))),
         };
+        // The events read every period, as the firmware and the benchmark read them.
+        while ctl.pop_event().is_some() {}
     }
     defmt::info!("trace_step done: {=u32} steps", ticks);
     exit::success()

@@ -12,7 +12,8 @@ with everything LLVM inlined into `Controller::step` sorted back into the paper'
                            [--lines [--within REGEX]]
 
 --lines adds the instructions per source line (innermost frame, with its inlining chain);
---within REGEX keeps only the lines of the categories matching REGEX (e.g. "Monitor").
+--within REGEX keeps only the lines of the categories or stages matching REGEX (e.g. "Monitor",
+"report"); each line is prefixed by its stage of the step.
 
 --mission-tick N profiles step N of the whole 20-h paper mission instead: the subject is
 examples/trace_step.rs (one `Controller::step` a tick, built with the flight profile:
@@ -231,9 +232,10 @@ def profile(a, pcs, what):
         cat = next((c for c, p in CATEGORIES if re.search(p, chain)), "other: " + full[-1])
         by_cat[cat] += 1
         by_fn[chains[pc][0]] += 1
-        by_stage[stage_of(full)] += 1
-        if re.search(a.within, cat):
-            by_line[where[pc] + "  [" + " < ".join(chains[pc][:3]) + "]"] += 1
+        stage = stage_of(full)
+        by_stage[stage] += 1
+        if re.search(a.within, cat) or re.search(a.within, stage):
+            by_line[stage + ": " + where[pc] + "  [" + " < ".join(chains[pc][:3]) + "]"] += 1
     total = len(pcs)
     print(f"{a.elf}: {what}")
     for cat, n in by_cat.most_common():

@@ -1,5 +1,5 @@
 //! The controller's events: what happened in a step, worth telling the ground about once, in
-//! a bounded queue that keeps the newest events and counts the ones it had to drop.
+//! a bounded queue that keeps the first events of a burst and counts the ones it had to drop.
 
 use heapless::Deque;
 
@@ -55,8 +55,11 @@ pub struct Event {
     pub kind: EventKind,
 }
 
-/// The controller's event queue: [`EVENT_CAPACITY`] events; when it is full a new event takes
-/// the place of the oldest unread one, which is counted as dropped.
+/// The controller's event queue: [`EVENT_CAPACITY`] events. When it is full, a new event is
+/// dropped and counted, and the unread ones are kept: in a burst the first events tell the cause
+/// (the fault, the health change it led to) and the later ones its consequences, so a reader
+/// that fell behind still learns what started it (first-fault retention), and the count tells
+/// it that more happened.
 #[derive(Clone, Debug)]
 pub(super) struct EventQueue {
     queue: Deque<Event, EVENT_CAPACITY>,
@@ -72,13 +75,10 @@ impl EventQueue {
         }
     }
 
-    /// Appends `e`; when the queue is full the oldest unread event makes room for it.
+    /// Appends `e`, or counts it as dropped when the queue is full.
     pub(super) fn push(&mut self, e: Event) {
-        if let Err(e) = self.queue.push_back(e) {
-            self.queue.pop_front();
+        if self.queue.push_back(e).is_err() {
             self.dropped = self.dropped.saturating_add(1);
-            // Room was made above: the push cannot fail.
-            let _ = self.queue.push_back(e);
         }
     }
 
@@ -118,30 +118,30 @@ mod tests {
     }
 
     #[test]
-    fn ring_keeps_the_newest_and_counts_the_overwritten() {
-        let mut ring = EventQueue::new();
-        assert_eq!(ring.pop(), None);
+    fn a_full_queue_keeps_the_first_events_and_counts_the_dropped() {
+        let mut q = EventQueue::new();
+        assert_eq!(q.pop(), None);
         for i in 0..3 {
-            ring.push(event(i));
+            q.push(event(i));
         }
-        assert_eq!((drain(&mut ring), ring.dropped()), (vec![0, 1, 2], 0));
-        // 16 + 5 unread: the 5 oldest are overwritten, counted before and after the read.
+        assert_eq!((drain(&mut q), q.dropped()), (vec![0, 1, 2], 0));
+        // 16 + 5 unread: the 5 newest are dropped, counted before and after the read.
         for i in 3..3 + EVENT_CAPACITY as u32 + 5 {
-            ring.push(event(i));
+            q.push(event(i));
         }
-        assert_eq!(ring.dropped(), 5);
-        let expected: Vec<u32> = (8..24).collect();
-        assert_eq!(drain(&mut ring), expected);
-        assert_eq!(ring.dropped(), 5);
-        // A partial read, then more than a ring's worth: only the unread are lost.
-        for i in 24..30 {
-            ring.push(event(i));
+        assert_eq!(q.dropped(), 5);
+        let expected: Vec<u32> = (3..19).collect();
+        assert_eq!(drain(&mut q), expected);
+        assert_eq!(q.dropped(), 5);
+        // A partial read makes room for as many: only what finds no room is lost.
+        for i in 24..40 {
+            q.push(event(i));
         }
-        assert_eq!(ring.pop().map(|e| e.tick), Some(24));
-        for i in 30..50 {
-            ring.push(event(i));
+        assert_eq!(q.pop().map(|e| e.tick), Some(24));
+        for i in 40..50 {
+            q.push(event(i));
         }
-        assert_eq!(ring.dropped(), 5 + 9);
-        assert_eq!(drain(&mut ring), (34..50).collect::<Vec<u32>>());
+        assert_eq!(q.dropped(), 5 + 9);
+        assert_eq!(drain(&mut q), (25..41).collect::<Vec<u32>>());
     }
 }
