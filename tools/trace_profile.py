@@ -18,7 +18,8 @@ with everything LLVM inlined into `Controller::step` sorted back into the paper'
 --mission-tick N profiles step N of the whole 20-h paper mission instead: the subject is
 examples/trace_step.rs (one `Controller::step` a tick, built with the flight profile:
 `cargo build --profile firmware --target thumbv7em-none-eabihf --features firmware
---example trace_step`), and the
+--example trace_step`; built with TSS_TRACE_REPLAY=1 it flies the firmware's 720-s replay
+instead, and N is a step of the replay, as in examples/bench_step.rs), and the
 instructions counted are those from the N-th entry into `Controller::run` (the step: decide,
 then report; or `Controller::step` or `::decide`, whichever LLVM kept as a function) to the
 return to the caller. The trace is streamed through a pipe, not stored (a late step is some 4·10^7 lines in).
