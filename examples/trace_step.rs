@@ -26,6 +26,9 @@ use tss_reel::recordings::mission;
 /// The firmware's built-in input: the first 720 s of the paper's mission.
 use tss_reel::recordings::replay;
 
+/// A recording: its sample ([l, α, α̇]) at a tick, `None` where it has none.
+type Recording = fn(u32) -> Option<[f32; 3]>;
+
 /// Whether this build flies the replay (`TSS_TRACE_REPLAY` set at build time).
 const REPLAY: bool = matches!(option_env!("TSS_TRACE_REPLAY"), Some(v) if !v.is_empty());
 
@@ -50,7 +53,7 @@ fn main() -> ! {
         exit::failure();
     };
     let cfg = *ctl.config();
-    let (ticks, orbit_rate_radps, sample): (u32, f32, fn(u32) -> Option<[f32; 3]>) = if REPLAY {
+    let (ticks, orbit_rate_radps, sample): (u32, f32, Recording) = if REPLAY {
         (
             replay::SAMPLES.len() as u32,
             replay::ORBIT_RATE_RADPS,
@@ -66,7 +69,7 @@ fn main() -> ! {
             length_m: s[0],
             reel_rate_mps: previous_length.map(|l| (s[0] - l) / cfg.period_s),
             tension_n: load_cell::tension_n(
-                &sample,
+                sample,
                 tick,
                 cfg.period_s,
                 &cfg.masses,
