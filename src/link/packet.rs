@@ -9,15 +9,13 @@ use serde::de::{Error as _, SeqAccess, Visitor};
 use serde::ser::SerializeTuple;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-use crate::pus::{MAX_TC_LEN, MAX_TM_LEN};
+use super::params::PARAM_WORDS;
 
-/// The longest packet a `Packet` frame carries: the longest telecommand (the parameter-table
-/// load, `pus::MAX_TC_LEN`) or telemetry packet (`pus::MAX_TM_LEN`), whichever is longer.
-pub const MAX_PACKET_LEN: usize = if MAX_TC_LEN > MAX_TM_LEN {
-    MAX_TC_LEN
-} else {
-    MAX_TM_LEN
-};
+/// The longest packet a `Packet` frame carries, bytes: the parameter-table load, the longest
+/// packet either way (a PUS-C telecommand: 13 bytes of headers and error control, then the
+/// table's words and their CRC-32). The unit's PUS services check at compile time that every
+/// packet they accept or send fits (`pus::MAX_TC_LEN`, `pus::MAX_TM_LEN`).
+pub const MAX_PACKET_LEN: usize = 13 + 4 * PARAM_WORDS + 4;
 
 /// One space packet, 1 ..= [`MAX_PACKET_LEN`] bytes (on the wire: its length, u16
 /// little-endian, then its bytes).

@@ -30,7 +30,7 @@ use spacepackets::{CcsdsPacket, PacketType, SpHeader};
 
 pub use crate::controller::ModeCommand;
 use crate::controller::Refusal;
-use crate::link::{ParamTable, PARAM_WORDS};
+use crate::link::{ParamTable, MAX_PACKET_LEN, PARAM_WORDS};
 
 pub mod port;
 mod unit;
@@ -52,6 +52,9 @@ pub const TABLE_LOAD_LEN: usize = 4 * PARAM_WORDS + 4;
 
 /// The longest telecommand the unit accepts (the parameter-table load).
 pub const MAX_TC_LEN: usize = TC_OVERHEAD_LEN + TABLE_LOAD_LEN;
+
+// Every packet the unit accepts or sends fits the link's `Packet` frame.
+const _: () = assert!(MAX_TC_LEN <= MAX_PACKET_LEN && MAX_TM_LEN <= MAX_PACKET_LEN);
 
 /// CRC-32/ISO-HDLC of the parameter table's words (as in the PIL link's frames).
 const TABLE_CRC: crc::Crc<u32, crc::NoTable> =
