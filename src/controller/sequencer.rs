@@ -121,7 +121,6 @@ impl<T: Real> CarriedBlend<T> {
     /// e^{−cτ} however many periods it is carried, and 1 − E′ = (1 − E′_hi) − E′_lo keeps its
     /// own precision (the first difference is exact for E′ ≥ ½). After a gap in the calls E is
     /// worked out afresh as 2^{k·(−cΔt·log₂e)}.
-    #[inline(always)]
     fn carry_to(&mut self, tick: u32) -> Blend<T> {
         let (last_tick, last) = self.last;
         let now = match tick.wrapping_sub(last_tick) {
