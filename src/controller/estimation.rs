@@ -25,7 +25,7 @@ pub const MAX_CARRIED_PERIODS: u32 = 32;
 /// variance (its standard deviation ten times the sensor's), and stays so until an α sample is
 /// used again: the estimator exists to be better than the sensor. With the paper's tuning a
 /// swing sensor silent after a settled estimate gets there in the time measured by
-/// `tests/estimator.rs::a_silent_swing_sensor_is_flown_through_until_the_estimate_is_useless`.
+/// `tests/estimator/closed_loop.rs::a_silent_swing_sensor_is_flown_through_until_the_estimate_is_useless`.
 pub const MAX_ALPHA_VARIANCE_IN_SAMPLES: f64 = 100.0;
 
 /// The largest |α| the law flies on, rad (≈ 89°): beyond it the swing is a libration outside

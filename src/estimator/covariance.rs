@@ -58,7 +58,7 @@ impl<T: Real> Sym3<T> {
     /// period. Without it, a long dropout (d's growing uncertainty drives α and α̇ alike, so P
     /// tends to rank one: correlations of 0.9999 and beyond) meets the f32 rounding of each
     /// period (6e-8) and P turns indefinite within a day
-    /// (`tests/estimator.rs::a_dropout_of_days_stays_bounded_in_f32`).
+    /// (`tests/estimator/model_and_faults.rs::a_dropout_of_days_stays_bounded_in_f32`).
     pub(super) fn rounding_loaded(&self) -> Self {
         let grow = T::ONE + T::from_f64(ROUNDING_LOAD);
         Self {

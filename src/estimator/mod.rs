@@ -37,7 +37,7 @@
 //! term is of relative size (|u| + |k|)⁴/120: at most 5·10⁻⁴ inside the admitted
 //! |u| ≤ [`MAX_STRETCH_PER_PERIOD`], 1.1·10⁻⁵ at the paper's release (l = 1 m, l̇ = 0.1 m/s,
 //! u = 0.19), below 10⁻¹⁰ beyond l ≈ 20 m. The whole step's error against the simulator's plant
-//! integrated finely (`tests/estimator.rs::one_period_matches_the_plant`) is larger at the
+//! integrated finely (`tests/estimator/model_and_faults.rs::one_period_matches_the_plant`) is larger at the
 //! release, where s changes by 10 % within the period and the midpoint rule dominates:
 //! 7·10⁻⁴ of the period's α̇ change (1.3e-7 rad/s) and 1.5e-6 rad in α; 1.5·10⁻⁵ of it at
 //! l = 20 m; from 100 m on, below 1e-10 rad and 1e-13 rad/s. Against σ_α = 1e-4 rad and an
@@ -59,7 +59,7 @@
 //! because d̂ → κ b takes up the stiffness mismatch: with a 1e-3 rad bias, in stage 1 of the
 //! paper's mission from 1 h on, α̇̂'s error is 5.7e-8 rad/s RMS with a mean of −1.1e-8; the
 //! same filter without d (its drift and prior at their floors) errs by 3.6e-6 rad/s RMS
-//! (`tests/estimator.rs::a_constant_sensor_bias_leaves_the_rate_unbiased`).
+//! (`tests/estimator/model_and_faults.rs::a_constant_sensor_bias_leaves_the_rate_unbiased`).
 //!
 //! # Tuning ([`Config::paper`]) and the noise it assumes
 //!
@@ -71,7 +71,7 @@
 //!   at 9 km (2n δl̇/l = 2.4e-10 rad/s²). It does not cover an eccentric orbit flown on the
 //!   circular model: at e = 1e-3 (θ̈ up to 2e n² = 2.2e-9 rad/s², at orbital frequency) α̇̂
 //!   errs by 1.7e-7 rad/s RMS in stage 1, 3.1e-8 with the true θ̈ and μ/R³ in the [`Drive`]
-//!   (`tests/estimator.rs::an_eccentric_orbit_needs_its_orbit_terms_in_the_drive`). The filter's bandwidth grows as q_d^(1/6), its α̇ noise
+//!   (`tests/estimator/model_and_faults.rs::an_eccentric_orbit_needs_its_orbit_terms_in_the_drive`). The filter's bandwidth grows as q_d^(1/6), its α̇ noise
 //!   roughly as q_d^(1/4): a faster drift buys tracking with noise.
 //! - α̈ white noise of density 1e-9 rad/s² per √Hz: above the f32 rounding of one step.
 //! - At the start, α̇ within σ = 2e-3 rad/s (twice the orbit rate: any swing the law
@@ -106,7 +106,7 @@
 //! first-order term p_i δ_j is at most two roundings of √(P_ii P_jj) (|p_i K_i| ≤ P_ii), the
 //! size of the rounding the Joseph form itself carries in f32 (its correction c = p − S K is
 //! that rounding). What keeps P positive semidefinite in f32 is the same for both
-//! (`tests/estimator.rs::updates_after_dropouts_of_any_length_keep_the_covariance_positive_definite`):
+//! (`tests/estimator/model_and_faults.rs::updates_after_dropouts_of_any_length_keep_the_covariance_positive_definite`):
 //! a negative rounding residue v on the diagonal becomes |v| (the residue cut to zero, plus the
 //! non-negative diagonal |v|: positive semidefinite wherever the cut one is, and never less
 //! certain), and the rounding load below. After each prediction a variance
