@@ -2,7 +2,7 @@
 //!
 //! Flies `tss_reel::reel_drive::SpeedLoop` (the example reel, 1 kHz) against a small drum
 //! model and prints, with defmt, how many instructions one [`SpeedLoop::step`] takes (median,
-//! 99th percentile, worst, per brake state) against the ceiling of 250 (issue 30), and what a
+//! 99th percentile, worst, per brake state) against the ceiling of 250, and what a
 //! [`SpeedLoop::set_command`] (once a law period) and a [`SpeedLoop::paid_out_m`] (telemetry)
 //! cost. The inputs visit every branch of the step:
 //!
@@ -53,7 +53,7 @@ mod bench {
     /// figures are then 0.
     const TRACED: bool = option_env!("TSS_BENCH_TRACED").is_some();
 
-    /// The ceiling for one inner step (issue 30), checked against the worst case.
+    /// The ceiling for one inner step, checked against the worst case.
     pub const BUDGET_INSTRUCTIONS: u32 = 250;
 
     /// The test drum of `tests/reel_drive.rs`, in f32 with an f64 angle (outside the timing):

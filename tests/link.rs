@@ -393,7 +393,7 @@ fn fault() -> impl Strategy<Value = Fault> {
 proptest! {
     #![proptest_config(ProptestConfig { cases: 10_000, ..config() })]
 
-    /// Issue 16 §4: the end-of-run accounting is exact whatever the loss pattern, lost first
+    /// The end-of-run accounting is exact whatever the loss pattern, lost first
     /// and last frames included: the gate, fed what the firmware would receive period by
     /// period and closed by `End`, counts exactly the faults the plant injected. Telecommand
     /// packets before a period's sample and housekeeping requests after its command are

@@ -1,4 +1,4 @@
-//! The flight speed loop in the elastic closed loop (issue 19 §Simulator): `reel.model =
+//! The flight speed loop in the elastic closed loop: `reel.model =
 //! "flight_drive"` flies `tss_reel::reel_drive::SpeedLoop` at 1 kHz against the truth model's
 //! drum, the tether loaded by the drum's actual motion; the summary reports its tracking,
 //! saturation, faults and the tension at the reel. A short window of the paper's mission
@@ -60,11 +60,9 @@ fn tracking_and_saturation_follow_the_motor_torque() {
     assert_eq!(weak.released_ticks, 0, "{weak:?}");
 }
 
-/// A drive trip reaches the outer controller's health, as on the board (issue 28 §2: before,
-/// host-sim never called `Controller::step_with_drive`, and the weak motor's `MotorStall`
-/// trip flew 3.4 m/s RMS of tracking error, slack for the whole run, "faults raised: none",
-/// health nominal): the controller goes to safe hold in the period after the trip and stays
-/// there (the trip is never cleared), and the summary names the fault.
+/// A drive trip reaches the outer controller's health, as on the board: the controller goes
+/// to safe hold in the period after the trip and stays there (the trip is never cleared), and
+/// the summary names the fault.
 #[test]
 fn a_drive_trip_puts_the_outer_controller_in_safe_hold() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper-drive.toml");

@@ -18,7 +18,7 @@
 //!   a host-linked run with sensor dropouts at exactly the ticks the firmware had no sample
 //!   computes the same commands bit for bit.
 //! - `a_lost_first_frame_does_not_stop_the_link` and
-//!   `heavy_link_faults_at_the_start_and_the_end_are_counted_exactly` (issue 16 §4): short runs
+//!   `heavy_link_faults_at_the_start_and_the_end_are_counted_exactly`: short runs
 //!   with every sample frame faulted (all four kinds, several seeds), the first and the last
 //!   frames among them: the link starts, every period flies, and both ends agree exactly.
 //! - `commanded_missions_fly_in_pil_as_on_the_host`: the commanded missions of `scenarios/`
@@ -366,7 +366,7 @@ fn assert_exact_accounting(sc: &Scenario, elf: &Path, name: &str) -> PilReport {
     report
 }
 
-/// Issue 16 §4: with the first sample frame corrupted (seed 3, half the frames corrupted) the
+/// With the first sample frame corrupted (seed 3, half the frames corrupted) the
 /// firmware used to wait for a first good frame while the plant waited for the command of tick
 /// 0: a 60 s deadlock, then "no command for tick 0".
 #[test]
@@ -387,7 +387,7 @@ fn a_lost_first_frame_does_not_stop_the_link() {
     assert_eq!(report.ticks, 6);
 }
 
-/// Issue 16 §4: every sample frame meets a fault (a quarter each of dropped, corrupted,
+/// Every sample frame meets a fault (a quarter each of dropped, corrupted,
 /// duplicated, reordered), over several seeds; among them runs whose first and whose last
 /// frames are lost. Every period flies and the end-of-run counts agree exactly (on main the
 /// gaps of frames lost after the last one that arrived were not counted).

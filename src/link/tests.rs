@@ -227,7 +227,7 @@ fn the_gate_drops_duplicates_and_late_frames_and_counts_gaps() {
     );
 }
 
-/// Issue 16 §4: frames lost before the first that arrives and after the last are gaps too.
+/// Frames lost before the first that arrives and after the last are gaps too.
 #[test]
 fn the_gate_counts_frames_lost_at_the_start_and_the_end() {
     let mut g = SampleGate::new();

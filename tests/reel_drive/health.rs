@@ -1,4 +1,4 @@
-//! (A module of `tests/reel_drive.rs`.) The reel drive's faults reach the outer controller's health (issue 19 §3): every
+//! (A module of `tests/reel_drive.rs`.) The reel drive's faults reach the outer controller's health: every
 //! [`DriveFault`] through [`Controller::step_with_drive`], against the mapping of
 //! [`DriveFault::outer_reaction`], on the paper's mission as the reel MCU senses it.
 
