@@ -53,11 +53,11 @@ pub(super) struct CrossChecks {
     /// Consecutive judged ticks with the drum not answering the torque (T̂ beyond any tether,
     /// or, the load cell dropped, the integral at its clamp).
     unanswered_ticks: u32,
-    /// Consecutive judged ticks with T̂ away from the load cell.
+    /// Consecutive judged ticks with T̂ away from the load cell, while it is trusted.
     mismatch_ticks: u32,
     /// Whether the feed-forward uses the load cell (false after
-    /// [`DriveFault::TensionMismatch`], until `clear_trip`).
-    pub(super) load_cell_trusted: bool,
+    /// [`DriveFault::TensionMismatch`], until [`CrossChecks::trust_load_cell`]).
+    load_cell_trusted: bool,
     /// The total count (modulo 2³²) where the engaged brake first held the drum; `None` while
     /// the brake is free, and until the first reading after it engaged.
     pub(super) held_at_count: Option<u32>,
@@ -86,6 +86,17 @@ impl CrossChecks {
         load_cell_trusted: true,
         held_at_count: None,
     };
+
+    /// Whether the feed-forward uses the load cell.
+    pub(super) fn load_cell_trusted(&self) -> bool {
+        self.load_cell_trusted
+    }
+
+    /// Trusts the load cell again, its disagreement counted afresh.
+    pub(super) fn trust_load_cell(&mut self) {
+        self.load_cell_trusted = true;
+        self.mismatch_ticks = 0;
+    }
 
     /// Restarts the observer at a release: the drum's speed as measured, the tether's torque
     /// as the feed-forward takes it. D̂ = K (J / r) (v − v̂) holds that torque when the model's
@@ -143,7 +154,9 @@ impl CrossChecks {
         }
         self.unanswered_ticks = 0;
         if trusted {
-            self.mismatch_ticks = self.mismatch_ticks.saturating_add(gap_ticks);
+            // (Cannot wrap: below `ticks` while the load cell is trusted, for it is dropped at
+            // `ticks` and trusted again from 0, plus a gap below 2³¹.)
+            self.mismatch_ticks = self.mismatch_ticks.wrapping_add(gap_ticks);
             if self.mismatch_ticks >= j.ticks {
                 self.load_cell_trusted = false;
                 return Some(DriveFault::TensionMismatch);
@@ -232,6 +245,16 @@ mod tests {
         }
         assert_eq!(judge(&mut c, 2.0, 19.9), Some(DriveFault::TensionMismatch));
         assert!(!c.load_cell_trusted);
+        // Trusted again, the disagreement must last its ticks once more.
+        let mut again = c;
+        again.trust_load_cell();
+        for _ in 0..9 {
+            assert_eq!(judge(&mut again, 2.0, 19.9), None);
+        }
+        assert_eq!(
+            judge(&mut again, 2.0, 19.9),
+            Some(DriveFault::TensionMismatch)
+        );
         // Untrusted, only the plausibility is judged.
         for _ in 0..20 {
             assert_eq!(judge(&mut c, 2.0, 0.0), None);

@@ -372,7 +372,7 @@ impl SpeedLoop {
     /// Whether the feed-forward uses the load cell (false after
     /// [`DriveFault::TensionMismatch`], until [`clear_trip`](Self::clear_trip)).
     pub fn load_cell_trusted(&self) -> bool {
-        self.checks.load_cell_trusted
+        self.checks.load_cell_trusted()
     }
 
     /// The parts of the last step's torque ([`DriveOutput::torque_nm`] is their sum): with
@@ -477,7 +477,7 @@ impl SpeedLoop {
             Brake::Tripped(f) => f,
             Brake::MotorHold => DriveFault::BrakeSlip,
             Brake::Engaged | Brake::Releasing { .. } | Brake::Released { .. } => {
-                self.checks.load_cell_trusted = true;
+                self.checks.trust_load_cell();
                 return None;
             }
         };
@@ -520,7 +520,7 @@ impl SpeedLoop {
         let (counted, speed_mps) = self.odometry(tick, gap_ticks, input.encoder_count, &mut faults);
         let counted = counted.is_ok();
         // A dropped load cell is reported by every step, and the feed-forward takes no tension.
-        let tension_n = if self.checks.load_cell_trusted {
+        let tension_n = if self.checks.load_cell_trusted() {
             load_cell_n
         } else {
             faults.insert(DriveFault::TensionMismatch);
