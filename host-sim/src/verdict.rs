@@ -6,7 +6,9 @@
 //!   tether librates over the top, outside every law's domain, Eq. 5 and docs/equations.md §3);
 //! - **Spool overrun**: the tether paid out to the end of its spool
 //!   (`envelope.max_length_m`, the tether the main satellite carries): the run stops there;
-//! - **Slack tether**: the tension at the reel was ≤ 0 at a control tick;
+//! - **Slack tether**: the tension at the reel was ≤ 0 at a control tick from the point the
+//!   tether must be taut on (`simulation.taut_from_length_m`, docs/equations.md §17.7; from the
+//!   start by default), the criterion of the Monte Carlo campaigns too;
 //! - **Drive trip**: the flight drive (`reel.model = "flight_drive"`) raised a fault;
 //! - **Stalled mission**: the controller flagged no progress, ended the run in safe hold, or
 //!   stage 1 never reached its keep length before stage 2 began.
@@ -38,15 +40,17 @@ pub enum Failure {
         /// The spool's length (`envelope.max_length_m`), m.
         spool_m: f64,
     },
-    /// The tension at the reel fell to ≤ 0.
+    /// The tension at the reel fell to ≤ 0 from the point the tether must be taut on.
     Slack {
-        /// Start of the first slack episode, s.
+        /// The length from which the tether must be taut, m (0: from the start).
+        from_length_m: f64,
+        /// Start of the first slack episode from that point, s.
         first_s: f64,
         /// Slack episodes.
         episodes: u32,
         /// Time slack in all, s.
         total_s: f64,
-        /// The least tension, N.
+        /// The least tension from that point, N.
         min_tension_n: f64,
     },
     /// The flight drive raised faults.
@@ -95,14 +99,22 @@ impl Failure {
                  (the run stopped there)"
             ),
             Self::Slack {
+                from_length_m,
                 first_s,
                 episodes,
                 total_s,
                 min_tension_n,
-            } => format!(
-                "slack tether: {episodes} episode(s), {total_s:.0} s in all, from {first_s:.0} s \
-                 (least tension {min_tension_n:.4} N)"
-            ),
+            } => {
+                let taut_from = if *from_length_m > 0.0 {
+                    format!(" once {from_length_m} m long")
+                } else {
+                    String::new()
+                };
+                format!(
+                    "slack tether{taut_from}: {episodes} episode(s), {total_s:.0} s in all, from \
+                     {first_s:.0} s (least tension {min_tension_n:.4} N)"
+                )
+            }
             Self::DriveTrip { fault_bits } => {
                 format!("drive trip: flight drive faults {fault_bits:#06x} (DriveFault::ALL order)")
             }
@@ -142,12 +154,21 @@ impl Verdict {
                 spool_m: o.spool_m,
             });
         }
-        if f.slack_s > 0.0 {
+        let taut = &f.taut;
+        if let (Some(from_s), true) = (taut.from_s, taut.slack_s > 0.0) {
+            // The first episode that lasts to the point or begins after it (one already slack
+            // at the point counts from there).
+            let first_s = f
+                .slack_episodes
+                .iter()
+                .find(|(_, end_s)| *end_s > from_s)
+                .map_or(f64::NAN, |(start_s, _)| start_s.max(from_s));
             failures.push(Failure::Slack {
-                first_s: f.slack_episodes.first().map_or(f64::NAN, |e| e.0),
-                episodes: f.slack_events,
-                total_s: f.slack_s,
-                min_tension_n: f.min_tension_n.0,
+                from_length_m: taut.from_length_m,
+                first_s,
+                episodes: taut.slack_events,
+                total_s: taut.slack_s,
+                min_tension_n: taut.min_tension_n.0,
             });
         }
         let drive_bits = h
@@ -244,11 +265,13 @@ impl Verdict {
                     ("spool_m", json_number(*spool_m)),
                 ],
                 Failure::Slack {
+                    from_length_m,
                     first_s,
                     episodes,
                     total_s,
                     min_tension_n,
                 } => vec![
+                    ("from_length_m", json_number(*from_length_m)),
                     ("first_s", json_number(*first_s)),
                     ("episodes", episodes.to_string()),
                     ("total_s", json_number(*total_s)),

@@ -116,6 +116,46 @@ fn a_slack_tether_is_headlined_as_a_failure() {
     assert!(verdict.contains("\"kind\": \"slack\""), "{verdict}");
 }
 
+/// The same slack counts only from the point the tether must be taut on
+/// (`simulation.taut_from_length_m`): a point the run never reaches leaves no slack in the
+/// verdict, and one reached in the middle of the slack episode (about 145 m, 24 s into it)
+/// counts the episode from there.
+#[test]
+fn slack_fails_the_verdict_only_from_the_point_the_tether_must_be_taut_on() {
+    let corrupt =
+        "faults.corrupt=[{ sensor = \"alpha\", from_s = 3600.0, until_s = 1e9, value = 0.0 }]";
+    let taut_from = |length_m: &str| {
+        fly(
+            "paper-reel-limits.toml",
+            &[
+                corrupt,
+                "simulation.duration_s=21600",
+                &format!("simulation.taut_from_length_m={length_m}"),
+            ],
+        )
+    };
+    let (stdout, verdict, faults) = taut_from("1e9");
+    let first = stdout.lines().next().unwrap_or_default();
+    assert!(!first.contains("slack"), "{first}");
+    assert!(!verdict.contains("\"kind\": \"slack\""), "{verdict}");
+    assert!(faults.contains("slack (T ≤ 0): 1 events"), "{faults}");
+
+    let (stdout, verdict, _) = taut_from("145");
+    let first = stdout.lines().next().unwrap_or_default();
+    assert!(
+        first.contains("slack tether once 145 m long: 1 episode(s)"),
+        "{first}"
+    );
+    let number = |key: &str| -> f64 {
+        let at = verdict.find(&format!("\"{key}\": ")).unwrap() + key.len() + 4;
+        let end = verdict[at..].find([',', '}']).unwrap() + at;
+        verdict[at..end].parse().unwrap()
+    };
+    let (first_s, total_s) = (number("first_s"), number("total_s"));
+    assert!((3620.0..3650.0).contains(&first_s), "{verdict}");
+    assert!(total_s > 0.0 && total_s < 71.0 - 10.0, "{verdict}");
+}
+
 /// The swing sensor stuck from 1 h: the controller finds it stuck and holds the reel in safe
 /// hold, so the deployment stops short of the keep; the run's headline and verdict say the
 /// mission stalled.
