@@ -825,17 +825,18 @@ impl SpeedLoop {
     fn take_tension(&mut self, reading: Option<f32>, faults: &mut DriveFaults) -> f32 {
         let (lo, hi) = (self.cfg.faults.min_tension_n, self.cfg.faults.max_tension_n);
         match reading {
-            Some(t) if t >= lo => {
-                if t <= hi {
+            Some(t) if t <= hi => {
+                if t >= lo {
                     self.load_cell_n = t;
                     return t;
                 }
+                // Below the range: clamped if finite (−∞ is not).
                 if t.is_finite() {
-                    self.load_cell_n = hi;
+                    self.load_cell_n = lo;
                 }
             }
-            // (Below the range, or NaN: the finite ones are below.)
-            Some(t) if t.is_finite() => self.load_cell_n = lo,
+            // Above the range (clamped if finite), or NaN.
+            Some(t) if t.is_finite() => self.load_cell_n = hi,
             Some(_) | None => {}
         }
         faults.insert(DriveFault::TensionOutOfRange);

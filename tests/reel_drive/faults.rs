@@ -202,6 +202,7 @@ fn tension_readings_out_of_range_are_typed_and_bounded() {
         (Some(f32::INFINITY), 20.0),
         (Some(500.0), 200.0),
         (Some(-50.0), -5.0),
+        (Some(f32::NEG_INFINITY), -5.0),
     ] {
         let mut input = run.input();
         input.tension_n = reading;
