@@ -56,6 +56,22 @@ mod bench {
     /// The ceiling for one inner step, checked against the worst case.
     pub const CEILING_INSTRUCTIONS: u32 = 250;
 
+    /// The meter's worst case carries up to this many instructions of SysTick quantisation and
+    /// of the call's own cost (`scripts/bench-target`): one this close to the ceiling is judged
+    /// on the exact count of the execution trace (`TSS_BENCH_EXACT=1`).
+    pub const METER_MARGIN_INSTRUCTIONS: u32 = 10;
+
+    /// Whether the meter's `worst` says the ceiling holds.
+    pub fn verdict(worst: u32) -> &'static str {
+        if worst + METER_MARGIN_INSTRUCTIONS <= CEILING_INSTRUCTIONS {
+            "holds"
+        } else if worst > CEILING_INSTRUCTIONS + METER_MARGIN_INSTRUCTIONS {
+            "EXCEEDED"
+        } else {
+            "within the meter's margin, judged on the exact count"
+        }
+    }
+
     /// The test drum of `tests/reel_drive.rs`, in f32 with an f64 angle (outside the timing):
     /// J 10 % and friction 20/25 % above the loop's model, 20 N of tension.
     struct Drum {
@@ -242,7 +258,7 @@ mod bench {
             s.max.1,
             s.mean(),
             CEILING_INSTRUCTIONS,
-            if s.max.0 <= CEILING_INSTRUCTIONS { "holds" } else { "EXCEEDED" }
+            verdict(s.max.0)
         );
         for (i, st) in r.states.iter().enumerate() {
             if st.n > 0 {
