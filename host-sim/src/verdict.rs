@@ -155,7 +155,7 @@ impl Verdict {
             });
         }
         let taut = &f.taut;
-        if let (Some(from_s), true) = (taut.from_s, taut.slack_s > 0.0) {
+        if let Some(from_s) = taut.from_s.filter(|_| taut.slack_s > 0.0) {
             // The first episode that lasts to the point or begins after it (one already slack
             // at the point counts from there).
             let first_s = f
